@@ -1,0 +1,73 @@
+#!/usr/bin/python3
+"""Summarise JUnit XML results from pytest, gtest and rostest into one report.
+
+Usage: test_summary.py DIR [DIR ...]
+
+Prints one line per result file with failures, then the totals as the plain closing line
+`N passed, N failed, N skipped`. Exit status 1 when anything failed or no test ran.
+rostest writes both a `rostest-*.xml` summary and the test node's `rosunit-*.xml`; only the
+summary is counted, so that no test counts twice.
+"""
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+
+def result_files(dirs):
+    for top in dirs:
+        for root, _, files in os.walk(top):
+            names = set(files)
+            for name in sorted(files):
+                if not name.endswith(".xml"):
+                    continue
+                if name.startswith("rosunit-") and any(n.startswith("rostest-") for n in names):
+                    continue
+                yield os.path.join(root, name)
+
+
+def count(path):
+    """Return (passed, failed, skipped, failed_case_names) for one JUnit file."""
+    try:
+        tree = ET.parse(path)
+    except ET.ParseError as err:
+        return 0, 1, 0, ["%s: unreadable result file (%s)" % (path, err)]
+    passed = failed = skipped = 0
+    failures = []
+    for case in tree.iter("testcase"):
+        name = "%s.%s" % (case.get("classname", ""), case.get("name", ""))
+        if case.find("failure") is not None or case.find("error") is not None:
+            failed += 1
+            failures.append(name)
+        elif case.find("skipped") is not None:
+            skipped += 1
+        else:
+            passed += 1
+    # A suite that crashed before its cases ran reports errors on the suite only.
+    for suite in tree.iter("testsuite"):
+        if not list(suite.iter("testcase")) and int(suite.get("errors", 0) or 0) > 0:
+            failed += 1
+            failures.append("%s (suite error)" % suite.get("name"))
+    return passed, failed, skipped, failures
+
+
+def main(dirs):
+    totals = [0, 0, 0]
+    for path in result_files(dirs):
+        p, f, s, failures = count(path)
+        totals[0] += p
+        totals[1] += f
+        totals[2] += s
+        rel = os.path.relpath(path)
+        print("  %-70s %4d passed %3d failed %3d skipped" % (rel[-70:], p, f, s))
+        for name in failures:
+            print("      FAILED: %s" % name)
+    print()
+    print("%d passed, %d failed, %d skipped" % tuple(totals))
+    if totals[0] + totals[1] == 0:
+        print("no test ran", file=sys.stderr)
+        return 1
+    return 1 if totals[1] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,93 @@
+/**
+ * @file costmap_2d.h
+ * @brief A 2D grid of navigation costs, free of ROS types (STYLE.md 1, 3).
+ *
+ * Cell (mx, my) is stored at index my * size_x + mx; cell (0, 0) is the one whose lower-left
+ * corner is the origin. Costs follow costmap_2d's cost_values.h.
+ */
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace mbot_navigation
+{
+/// Cost values, as in costmap_2d/cost_values.h.
+namespace cost
+{
+constexpr uint8_t FREE = 0;
+constexpr uint8_t INSCRIBED = 253;  ///< robot centre here means a collision
+constexpr uint8_t LETHAL = 254;     ///< an obstacle
+constexpr uint8_t NO_INFORMATION = 255;
+}  // namespace cost
+
+/// @brief A planar pose [m, m, rad].
+struct Pose2D
+{
+  double x = 0.0;
+  double y = 0.0;
+  double theta = 0.0;
+};
+
+/// @brief A rectangular grid of costs with a resolution [m/cell] and an origin [m] in its frame.
+class Costmap2D
+{
+public:
+  Costmap2D() = default;
+  Costmap2D(unsigned size_x, unsigned size_y, double resolution, double origin_x, double origin_y,
+            uint8_t default_cost = cost::FREE)
+    : size_x_(size_x), size_y_(size_y), resolution_(resolution), origin_x_(origin_x),
+      origin_y_(origin_y), costs_(static_cast<size_t>(size_x) * size_y, default_cost)
+  {
+  }
+
+  unsigned sizeX() const { return size_x_; }
+  unsigned sizeY() const { return size_y_; }
+  double resolution() const { return resolution_; }  ///< [m/cell]
+  double originX() const { return origin_x_; }       ///< [m]
+  double originY() const { return origin_y_; }       ///< [m]
+
+  size_t index(unsigned mx, unsigned my) const { return static_cast<size_t>(my) * size_x_ + mx; }
+  uint8_t cost(unsigned mx, unsigned my) const { return costs_[index(mx, my)]; }
+  void setCost(unsigned mx, unsigned my, uint8_t c) { costs_[index(mx, my)] = c; }
+  const uint8_t* data() const { return costs_.data(); }
+  uint8_t* data() { return costs_.data(); }
+
+  /// @brief World [m] to cell; false when outside the grid.
+  bool worldToMap(double wx, double wy, unsigned& mx, unsigned& my) const
+  {
+    if (wx < origin_x_ || wy < origin_y_) return false;
+    const double fx = (wx - origin_x_) / resolution_;
+    const double fy = (wy - origin_y_) / resolution_;
+    if (fx >= size_x_ || fy >= size_y_) return false;
+    mx = static_cast<unsigned>(fx);
+    my = static_cast<unsigned>(fy);
+    return true;
+  }
+
+  /// @brief Centre of a cell, in world coordinates [m].
+  void mapToWorld(unsigned mx, unsigned my, double& wx, double& wy) const
+  {
+    wx = origin_x_ + (mx + 0.5) * resolution_;
+    wy = origin_y_ + (my + 0.5) * resolution_;
+  }
+
+  /// @brief Move the origin (rolling window); costs are not shifted here.
+  void setOrigin(double ox, double oy)
+  {
+    origin_x_ = ox;
+    origin_y_ = oy;
+  }
+
+  void fill(uint8_t c) { std::fill(costs_.begin(), costs_.end(), c); }
+
+private:
+  unsigned size_x_ = 0;
+  unsigned size_y_ = 0;
+  double resolution_ = 0.05;
+  double origin_x_ = 0.0;
+  double origin_y_ = 0.0;
+  std::vector<uint8_t> costs_;
+};
+
+}  // namespace mbot_navigation
