@@ -51,3 +51,16 @@ print("CMAKE_ARGS=%s" % shlex.quote(" ".join(cfg.get("cmake_args", []))))
 print("PACKAGES=%s" % shlex.quote(" ".join(cfg["packages"])))
 PY
 }
+
+# Start a virtual X display for rviz (Mesa software GL); sets DISPLAY and XVFB_PID.
+start_xvfb() {
+  local fdfile
+  fdfile=$(mktemp)
+  Xvfb -displayfd 3 -screen 0 1280x960x24 -nolisten tcp 3>"$fdfile" >/dev/null 2>&1 &
+  XVFB_PID=$!
+  for _ in $(seq 100); do [ -s "$fdfile" ] && break; sleep 0.1; done
+  [ -s "$fdfile" ] || die "Xvfb did not start"
+  export DISPLAY=":$(cat "$fdfile")"
+  export LIBGL_ALWAYS_SOFTWARE=1
+  rm -f "$fdfile"
+}

@@ -5,8 +5,10 @@ Usage: test_summary.py DIR [DIR ...]
 
 Prints one line per result file with failures, then the totals as the plain closing line
 `N passed, N failed, N skipped`. Exit status 1 when anything failed or no test ran.
-rostest writes both a `rostest-*.xml` summary and the test node's `rosunit-*.xml`; only the
-summary is counted, so that no test counts twice.
+rostest writes a `rostest-*.xml` file with one case per test node (did it run and pass) and the
+node's own `rosunit-*.xml` with its test cases. The node's cases are counted; the rostest case
+counts only when it failed (the node crashed or timed out before writing its results), so that
+no test counts twice.
 """
 import os
 import sys
@@ -16,13 +18,9 @@ import xml.etree.ElementTree as ET
 def result_files(dirs):
     for top in dirs:
         for root, _, files in os.walk(top):
-            names = set(files)
             for name in sorted(files):
-                if not name.endswith(".xml"):
-                    continue
-                if name.startswith("rosunit-") and any(n.startswith("rostest-") for n in names):
-                    continue
-                yield os.path.join(root, name)
+                if name.endswith(".xml"):
+                    yield os.path.join(root, name)
 
 
 def count(path):
@@ -33,11 +31,14 @@ def count(path):
         return 0, 1, 0, ["%s: unreadable result file (%s)" % (path, err)]
     passed = failed = skipped = 0
     failures = []
+    only_failures = os.path.basename(path).startswith("rostest-")
     for case in tree.iter("testcase"):
         name = "%s.%s" % (case.get("classname", ""), case.get("name", ""))
         if case.find("failure") is not None or case.find("error") is not None:
             failed += 1
             failures.append(name)
+        elif only_failures:
+            continue
         elif case.find("skipped") is not None:
             skipped += 1
         else:

@@ -39,10 +39,24 @@ def test_counts_pass_fail_skip(tmp_path):
     assert code == 1
 
 
-def test_rosunit_duplicate_of_rostest_is_not_counted(tmp_path):
-    code, last = run(tmp_path, {"rostest-sim.xml": ROSTEST_XML, "rosunit-sim.xml": ROSTEST_XML})
+ROSTEST_NODE_RAN = """<?xml version="1.0"?>
+<testsuite name="s" tests="1"><testcase classname="rostest.runner.RosTest" name="testsim"/></testsuite>"""
+
+ROSTEST_NODE_DIED = """<?xml version="1.0"?>
+<testsuite name="s" tests="1"><testcase classname="rostest.runner.RosTest" name="testsim">
+<failure message="test [sim] did not generate test results"/></testcase></testsuite>"""
+
+
+def test_rostest_counts_the_node_cases_not_the_wrapper(tmp_path):
+    code, last = run(tmp_path, {"rostest-sim.xml": ROSTEST_NODE_RAN, "rosunit-sim.xml": ROSTEST_XML})
     assert last == "2 passed, 0 failed, 0 skipped"
     assert code == 0
+
+
+def test_rostest_wrapper_failure_counts_when_the_node_died(tmp_path):
+    code, last = run(tmp_path, {"rostest-sim.xml": ROSTEST_NODE_DIED})
+    assert last == "0 passed, 1 failed, 0 skipped"
+    assert code == 1
 
 
 def test_suite_error_without_cases_is_a_failure(tmp_path):

@@ -49,6 +49,17 @@ struct LaserSpec
   double mount_y = 0.0;        ///< [m]
   double mount_z = 0.0;        ///< [m]
   double mount_yaw = 0.0;      ///< [rad]
+
+  /// @brief Angle between neighbouring beams [rad]: 2*pi/beams for a full circle (the last beam
+  ///        is not a repeat of the first), else (max_angle - min_angle) / (beams - 1).
+  double angleIncrement() const
+  {
+    const double span = max_angle - min_angle;
+    const double two_pi = 6.283185307179586;
+    if (beams < 2) return 0.0;
+    if (span >= two_pi - 1e-9) return span / beams;
+    return span / (beams - 1);
+  }
 };
 
 /// @brief Velocity and acceleration limits, named as dwa_local_planner names them.
@@ -73,6 +84,7 @@ struct RobotModel
   double mass = 0.0;                   ///< total mass [kg] (sum of URDF link masses)
   double wheel_radius = 0.0;           ///< [m]
   double wheel_separation = 0.0;       ///< distance between left and right wheels [m]
+  double wheel_base = 0.0;             ///< distance between front and rear wheels [m] (0: one axle)
   std::vector<std::string> wheel_joints;  ///< unprefixed URDF joint names of the driven wheels
   LaserSpec laser;
   Limits limits;

@@ -1,0 +1,117 @@
+"""Run the project's benchmarks and report them as a table and JSON.
+
+    scripts/bench sim [--json FILE]   simulator real-time factor for N robots, ray casting rate
+    scripts/bench nav [--json FILE]   global plan time and length, DWA cycle time
+    scripts/bench all [--json FILE]
+
+Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
+Every program runs pinned to one core (taskset) so figures compare with single-threaded peers.
+"""
+import argparse
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED_BENCH = os.path.join(os.path.dirname(ROOT), "shared", "bench", "planner")
+
+# Simulator benchmark plan: robots -> (map, sim seconds). The 1000-robot run uses the same room
+# tiled 3x3 (60x60 m). Sim seconds are chosen so that each run takes tens of wall seconds.
+SIM_RUNS = [
+    (1, "bench_room.yaml", 120.0),
+    (10, "bench_room.yaml", 60.0),
+    (100, "bench_room.yaml", 20.0),
+    (1000, "bench_room_3x3.yaml", 10.0),
+]
+
+
+def program(package, name):
+    path = os.path.join(ROOT, "devel", "lib", package, name)
+    if not os.access(path, os.X_OK):
+        sys.exit("benchmark program %s is not built (looked for %s); run scripts/setup" % (name, path))
+    return path
+
+
+def run_json(cmd):
+    """Run a benchmark program on one core and return the JSON object it prints last."""
+    full = ["taskset", "-c", "0"] + cmd if shutil.which("taskset") else cmd
+    print("$ " + " ".join(cmd), file=sys.stderr)
+    out = subprocess.run(full, check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
+    lines = [l for l in out.strip().splitlines() if l.startswith("{")]
+    if not lines:
+        sys.exit("%s printed no JSON:\n%s" % (cmd[0], out))
+    return json.loads(lines[-1])
+
+
+def machine():
+    cpu = ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return "%s, %d cores, %s" % (cpu or platform.processor(), os.cpu_count(), platform.platform())
+
+
+def bench_sim():
+    rays = run_json([program("mbot_sim", "raycast_bench")])
+    rtf = {}
+    details = {}
+    for robots, map_name, seconds in SIM_RUNS:
+        r = run_json([program("mbot_sim", "sim_bench"), "--robots", str(robots),
+                      "--map", os.path.join(ROOT, "maps", map_name), "--seconds", str(seconds)])
+        rtf[str(robots)] = round(r["rtf"], 3)
+        details[str(robots)] = r
+    return {"rtf": rtf, "rays_per_second": rays["rays_per_second"], "sim_runs": details}
+
+
+def bench_nav():
+    plan = {}
+    for n in ("1000", "2000"):
+        r = run_json([program("mbot_navigation", "plan_bench"),
+                      "--map", os.path.join(SHARED_BENCH, "map_%s.pgm" % n),
+                      "--pairs", os.path.join(SHARED_BENCH, "pairs_%s.csv" % n), "--json"])
+        plan[n] = {k: r[k] for k in ("p50", "p95", "mean_path_cells", "failures")}
+    dwa = run_json([program("mbot_navigation", "dwa_bench")])
+    return {"plan_ms": plan, "dwa_ms": {"p50": dwa["p50"], "p99": dwa["p99"]}}
+
+
+def print_table(result):
+    if "rtf" in result:
+        print("\nSimulator (one core, as fast as possible, 360-beam 10 Hz lasers, 100 Hz physics)")
+        print("  %-8s %12s" % ("robots", "real-time x"))
+        for n, x in result["rtf"].items():
+            print("  %-8s %12.2f" % (n, x))
+        print("  ray casting: %.1f million rays/s" % (result["rays_per_second"] / 1e6))
+    if "plan_ms" in result:
+        print("\nGlobal planner (A*, shared inputs, planning only, one thread)")
+        print("  %-10s %8s %8s %12s %9s" % ("grid", "p50 ms", "p95 ms", "mean cells", "failures"))
+        for n, r in result["plan_ms"].items():
+            print("  %-10s %8.2f %8.2f %12.1f %9d" % (n + "^2", r["p50"], r["p95"],
+                                                     r["mean_path_cells"], r["failures"]))
+        print("\nDWA cycle: p50 %.2f ms, p99 %.2f ms" % (result["dwa_ms"]["p50"], result["dwa_ms"]["p99"]))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("what", choices=["sim", "nav", "all"])
+    parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
+    args = parser.parse_args(argv)
+    result = {}
+    if args.what in ("sim", "all"):
+        result.update(bench_sim())
+    if args.what in ("nav", "all"):
+        result.update(bench_nav())
+    result["machine"] = machine()
+    print_table(result)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=2)
+        print("\nwrote %s" % args.json)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""mbot_description: robot models of the mbot fleet and per-robot URDF prefixing."""

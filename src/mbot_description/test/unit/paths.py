@@ -1,0 +1,12 @@
+"""Paths shared by the plain Python tests (no ROS master, no sourced workspace needed)."""
+import os
+import sys
+
+PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+REPO_DIR = os.path.abspath(os.path.join(PACKAGE_DIR, "..", ".."))
+MAPS_DIR = os.path.join(REPO_DIR, "maps")
+URDF_DIR = os.path.join(PACKAGE_DIR, "urdf")
+MODELS = ("mbot", "mbot_omni")
+
+# Import mbot_description from the source tree, as the devel space would.
+sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
