@@ -7,6 +7,8 @@
  */
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -80,6 +82,51 @@ public:
   }
 
   void fill(uint8_t c) { std::fill(costs_.begin(), costs_.end(), c); }
+
+  /// @brief True when (mx, my) is a cell of the grid (signed, for coordinates computed by offsets).
+  bool inBounds(int mx, int my) const
+  {
+    return mx >= 0 && my >= 0 && mx < static_cast<int>(size_x_) && my < static_cast<int>(size_y_);
+  }
+
+  /// @brief Set every cell of the window [x0, xn) x [y0, yn) to `c` (the window is clipped).
+  void resetWindow(int x0, int y0, int xn, int yn, uint8_t c)
+  {
+    x0 = std::max(x0, 0);
+    y0 = std::max(y0, 0);
+    xn = std::min(xn, static_cast<int>(size_x_));
+    yn = std::min(yn, static_cast<int>(size_y_));
+    for (int y = y0; y < yn; ++y)
+      std::fill(costs_.begin() + index(x0, y), costs_.begin() + index(x0, y) + std::max(xn - x0, 0), c);
+  }
+
+  /**
+   * @brief Move the origin to (new_origin_x, new_origin_y) [m] snapped to whole cells, keeping the
+   *        costs of the cells that stay inside the grid (rolling window, as costmap_2d's
+   *        Costmap2D::updateOrigin); cells that enter the grid get `fill_cost`.
+   */
+  void updateOrigin(double new_origin_x, double new_origin_y, uint8_t fill_cost)
+  {
+    // Whole-cell shift, so that kept cells keep their exact world position.
+    // (The 1e-6 cell guards against 0.15 / 0.05 = 2.9999999999999996.)
+    const int dx = static_cast<int>(std::floor((new_origin_x - origin_x_) / resolution_ + 1e-6));
+    const int dy = static_cast<int>(std::floor((new_origin_y - origin_y_) / resolution_ + 1e-6));
+    if (dx == 0 && dy == 0) return;
+    std::vector<uint8_t> shifted(costs_.size(), fill_cost);
+    const int sx = static_cast<int>(size_x_);
+    const int sy = static_cast<int>(size_y_);
+    // New cell (x, y) was old cell (x + dx, y + dy).
+    const int x_lo = std::max(0, -dx), x_hi = std::min(sx, sx - dx);
+    for (int y = std::max(0, -dy); y < std::min(sy, sy - dy); ++y)
+    {
+      if (x_lo >= x_hi) break;
+      std::copy(costs_.begin() + index(x_lo + dx, y + dy), costs_.begin() + index(x_hi + dx, y + dy),
+                shifted.begin() + index(x_lo, y));
+    }
+    costs_.swap(shifted);
+    origin_x_ += dx * resolution_;
+    origin_y_ += dy * resolution_;
+  }
 
 private:
   unsigned size_x_ = 0;

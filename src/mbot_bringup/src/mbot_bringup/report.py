@@ -1,0 +1,153 @@
+"""Build the HTML report of a demo run: summary table, plots of what happened, rviz screenshot.
+
+    report.write_report(recording_json, world_yaml, out_dir, screenshot=None) -> path of index.html
+
+Uses matplotlib's Agg backend (no display needed).
+"""
+import html
+import json
+import math
+import os
+import shutil
+
+import numpy as np
+import yaml
+
+
+def read_pgm(path):
+    """A binary (P5) or ASCII (P2) PGM as a 2D uint8 array, first row = top of the image."""
+    with open(path, "rb") as f:
+        data = f.read()
+    tokens = []
+    pos = 0
+    while len(tokens) < 4:  # magic, width, height, maxval; '#' starts a comment
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            pos = data.index(b"\n", pos) + 1
+            continue
+        end = pos
+        while not data[end:end + 1].isspace():
+            end += 1
+        tokens.append(data[pos:end].decode("ascii"))
+        pos = end
+    magic, width, height, maxval = tokens[0], int(tokens[1]), int(tokens[2]), int(tokens[3])
+    if magic == "P5":
+        pixels = np.frombuffer(data, dtype=np.uint8, count=width * height, offset=pos + 1)
+    elif magic == "P2":
+        pixels = np.array(data[pos:].split()[: width * height], dtype=np.int32)
+    else:
+        raise ValueError("%s: not a PGM image (magic %r, expected P5 or P2)" % (path, magic))
+    return (pixels.reshape(height, width) * (255.0 / maxval)).astype(np.uint8)
+
+
+def load_map_for_plot(world_yaml):
+    """(image, extent) of the world's map for matplotlib's imshow, or (None, None)."""
+    with open(world_yaml) as f:
+        world = yaml.safe_load(f)
+    map_yaml = os.path.join(os.path.dirname(world_yaml), world["map"])
+    with open(map_yaml) as f:
+        meta = yaml.safe_load(f)
+    image = read_pgm(os.path.join(os.path.dirname(map_yaml), meta["image"]))
+    res = float(meta["resolution"])
+    ox, oy = float(meta["origin"][0]), float(meta["origin"][1])
+    h, w = image.shape
+    return image, (ox, ox + w * res, oy, oy + h * res)
+
+
+def plot_trajectories(rec, world_yaml, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 7))
+    image, extent = load_map_for_plot(world_yaml)
+    ax.imshow(image, cmap="gray", extent=extent, origin="upper", vmin=0, vmax=255)
+    for name in sorted(rec["robots"]):
+        r = rec["robots"][name]
+        if not r["x"]:
+            continue
+        line, = ax.plot(r["x"], r["y"], lw=1.5, label=name)
+        ax.plot(r["x"][0], r["y"][0], "o", color=line.get_color())
+        ax.annotate("", xy=(r["x"][-1] + 0.3 * math.cos(r["yaw"][-1]), r["y"][-1] + 0.3 * math.sin(r["yaw"][-1])),
+                    xytext=(r["x"][-1], r["y"][-1]), arrowprops=dict(arrowstyle="->", color=line.get_color()))
+    for c in rec["contacts"]:
+        ax.plot(c["x"], c["y"], "rx", ms=9)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("Ground-truth trajectories (o start, arrow end, x contact)")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_speeds(rec, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 3))
+    for name in sorted(rec["robots"]):
+        r = rec["robots"][name]
+        t, x, y = np.array(r["t"]), np.array(r["x"]), np.array(r["y"])
+        if len(t) < 2:
+            continue
+        speed = np.hypot(np.diff(x), np.diff(y)) / np.maximum(np.diff(t), 1e-9)
+        ax.plot(t[1:] - t[0], speed, lw=1, label=name)
+    ax.set_xlabel("sim time [s]")
+    ax.set_ylabel("speed [m/s]")
+    ax.set_title("Ground-truth speed")
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def summary_table(rec):
+    rows = []
+    for name in sorted(rec["robots"]):
+        r = rec["robots"][name]
+        rates = r.get("rates", {})
+        rows.append("<tr><td>%s</td><td>%.1f</td><td>%.1f</td><td>%.1f</td><td>%.2f</td><td>%s</td></tr>" % (
+            html.escape(name), rates.get("odom", 0.0), rates.get("scan", 0.0), rates.get("ground_truth", 0.0),
+            r["distance"], "%.2f" % r["min_range"] if r["min_range"] is not None else "-"))
+    return ("<table><tr><th>robot</th><th>odom [Hz]</th><th>scan [Hz]</th><th>ground truth [Hz]</th>"
+            "<th>moved [m]</th><th>nearest laser return [m]</th></tr>%s</table>" % "".join(rows))
+
+
+def write_report(recording_json, world_yaml, out_dir, screenshot=None):
+    """Write out_dir/index.html (plus its images); return the path of index.html."""
+    with open(recording_json) as f:
+        rec = json.load(f)
+    if not os.path.isdir(out_dir):
+        os.makedirs(out_dir)
+    plot_trajectories(rec, world_yaml, os.path.join(out_dir, "trajectories.png"))
+    plot_speeds(rec, os.path.join(out_dir, "speeds.png"))
+    shot = ""
+    if screenshot and os.path.exists(screenshot):
+        if os.path.abspath(os.path.dirname(screenshot)) != os.path.abspath(out_dir):
+            shutil.copy(screenshot, os.path.join(out_dir, "rviz.png"))
+            screenshot = os.path.join(out_dir, "rviz.png")
+        shot = '<h2>rviz</h2><img src="%s" alt="rviz screenshot">' % os.path.basename(screenshot)
+    contacts = "".join("<li>t = %.2f s: %s &harr; %s at (%.2f, %.2f)</li>" % (
+        c["t"], html.escape(c["a"]), html.escape(c["b"]), c["x"], c["y"]) for c in rec["contacts"])
+    speedup = rec["sim_seconds"] / rec["wall_seconds"] if rec.get("wall_seconds") else 0.0
+    page = """<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>mbot fleet demo report</title>
+<style>body{font-family:sans-serif;max-width:60em;margin:2em auto}table{border-collapse:collapse}
+td,th{border:1px solid #999;padding:0.2em 0.6em;text-align:right}img{max-width:100%%}</style></head>
+<body><h1>mbot fleet demo</h1>
+<p>World <code>%s</code>: %d robots, %.1f s of sim time in %.1f s of wall time (%.1fx real time).</p>
+<h2>What each robot did</h2>%s
+<h2>Contacts (%d)</h2><ul>%s</ul>
+<h2>Trajectories</h2><img src="trajectories.png" alt="trajectories">
+<h2>Speeds</h2><img src="speeds.png" alt="speeds">
+%s
+</body></html>
+""" % (html.escape(rec.get("world", "")), len(rec["robots"]), rec["sim_seconds"], rec.get("wall_seconds", 0.0),
+       speedup, summary_table(rec), len(rec["contacts"]), contacts or "<li>none</li>", shot)
+    index = os.path.join(out_dir, "index.html")
+    with open(index, "w") as f:
+        f.write(page)
+    return index

@@ -1,0 +1,81 @@
+/**
+ * @file particle_filter.h
+ * @brief A particle set for planar localization, free of ROS types: Gaussian initialization,
+ *        low-variance resampling with a fixed or adaptive particle count, and the pose estimate
+ *        (weighted mean and covariance). The models that move and weigh the particles are in
+ *        localization_models.h; PfLocalizer (localization_core.h) runs the whole cycle.
+ */
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "mbot_navigation/localization_math.h"
+#include "mbot_navigation/localization_models.h"
+
+namespace mbot_navigation
+{
+namespace localization
+{
+/// @brief Size of the particle set (amcl's min_particles/max_particles).
+///
+/// Instead of amcl's KLD sampling the count adapts with a simpler rule: after resampling, the
+/// particles are sorted into bins of bin_size_xy x bin_size_xy x bin_size_theta and the next set
+/// gets particles_per_bin particles per occupied bin, clamped to [min_particles, max_particles].
+/// A spread-out (uncertain) set covers many bins and keeps many particles; a converged set
+/// shrinks to min_particles. min_particles == max_particles gives a fixed count.
+struct ParticleFilterConfig
+{
+  int min_particles = 100;
+  int max_particles = 5000;
+  int particles_per_bin = 50;
+  double bin_size_xy = 0.5;              ///< [m] (amcl's pf histogram bins)
+  double bin_size_theta = 10.0 * M_PI / 180.0;  ///< [rad]
+};
+
+/// @brief The particle set and the operations on it that do not depend on the models.
+class ParticleFilter
+{
+public:
+  /// @throws std::invalid_argument for inconsistent counts or bin sizes
+  ParticleFilter(const ParticleFilterConfig& config, uint32_t seed);
+
+  /// @brief Replace the set by max_particles particles drawn from a Gaussian around `mean`,
+  ///        with the variances of `covariance` (xx, yy, theta-theta; cross terms are ignored).
+  void initGaussian(const Pose2D& mean, const std::array<double, 9>& covariance);
+
+  /// @brief Scale the weights to sum to 1 (uniform when they sum to 0 or are not finite).
+  void normalizeWeights();
+
+  /// @brief Draw a new set with low-variance (systematic) resampling and adapt its size; the
+  ///        new particles have equal weights.
+  void resample();
+
+  /// @brief Weighted mean pose and covariance of the set (circular mean for the heading).
+  PoseWithCovariance estimate() const;
+
+  /// @brief Number of occupied bins (see ParticleFilterConfig) of the current set.
+  size_t occupiedBins() const;
+
+  std::vector<Particle>& particles() { return particles_; }
+  const std::vector<Particle>& particles() const { return particles_; }
+  std::mt19937& rng() { return rng_; }
+  const ParticleFilterConfig& config() const { return config_; }
+
+private:
+  size_t countBins(const std::vector<size_t>& indices) const;
+
+  ParticleFilterConfig config_;
+  std::mt19937 rng_;
+  std::vector<Particle> particles_;
+};
+
+/// @brief Low-variance (systematic) resampling: `count` indices into `weights` (normalized),
+///        drawn with one random offset so that index i is picked floor or ceil of
+///        count * weights[i] times.
+std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count,
+                                      std::mt19937& rng);
+
+}  // namespace localization
+}  // namespace mbot_navigation

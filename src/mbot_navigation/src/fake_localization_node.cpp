@@ -1,0 +1,128 @@
+/**
+ * @file fake_localization_node.cpp
+ * @brief fake_localization for one robot (run it in the robot's namespace): the simulator's
+ *        ground truth and the robot's odometry give the map -> <ns>/odom transform, as
+ *        fake_localization does.
+ *
+ * Subscribes `odom` and `base_pose_ground_truth` (nav_msgs/Odometry); publishes tf
+ * `map -> <ns>/odom` at the odometry rate (post-dated by ~transform_tolerance, as amcl and
+ * fake_localization do), `amcl_pose` (PoseWithCovarianceStamped) and `particlecloud` (PoseArray,
+ * one pose). Parameters: ~robot (default: the namespace), ~global_frame_id (map),
+ * ~odom_frame_id (<robot>/odom), ~base_frame_id (<robot>/base_footprint),
+ * ~transform_tolerance (0.1 s). Sim time only: the ground truth exists only in simulation.
+ */
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "mbot_navigation/localization_core.h"
+#include "mbot_navigation/localization_ros.h"
+
+namespace mbot_navigation
+{
+namespace localization
+{
+class FakeLocalizationNode
+{
+public:
+  FakeLocalizationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+  {
+    StrictParams params(pnh);
+    const std::string robot = robotName(params, nh);
+    global_frame_ = params.getString("global_frame_id", "map");
+    odom_frame_ = params.getString("odom_frame_id", prefixedFrame(robot, "odom"));
+    base_frame_ = params.getString("base_frame_id", prefixedFrame(robot, "base_footprint"));
+    transform_tolerance_ = ros::Duration(params.getDouble("transform_tolerance", 0.1));
+    params.checkNoUnknown();
+    if (!ros::Time::isSimTime())
+      throw std::runtime_error("fake_localization needs /use_sim_time true: it reads the "
+                               "simulator's ground truth, which only exists in simulation");
+
+    pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
+    cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
+    odom_sub_ = nh.subscribe("odom", 20, &FakeLocalizationNode::onOdometry, this);
+    truth_sub_ = nh.subscribe("base_pose_ground_truth", 20, &FakeLocalizationNode::onGroundTruth, this);
+    ROS_INFO("fake_localization: %s -> %s from %s and %s", global_frame_.c_str(), odom_frame_.c_str(),
+             truth_sub_.getTopic().c_str(), odom_sub_.getTopic().c_str());
+  }
+
+private:
+  void onOdometry(const nav_msgs::Odometry& msg)
+  {
+    if (!msg.header.frame_id.empty() && msg.header.frame_id != odom_frame_)
+      ROS_WARN_ONCE("fake_localization: odometry is in frame '%s', expected '%s' (~odom_frame_id)",
+                    msg.header.frame_id.c_str(), odom_frame_.c_str());
+    if (!msg.child_frame_id.empty() && msg.child_frame_id != base_frame_)
+      ROS_WARN_ONCE("fake_localization: odometry is of frame '%s', expected '%s' (~base_frame_id)",
+                    msg.child_frame_id.c_str(), base_frame_.c_str());
+    matcher_.addOdometry({static_cast<int64_t>(msg.header.stamp.toNSec()), toPose2D(msg.pose.pose)});
+    publishMatches();
+  }
+
+  void onGroundTruth(const nav_msgs::Odometry& msg)
+  {
+    matcher_.addGroundTruth({static_cast<int64_t>(msg.header.stamp.toNSec()), toPose2D(msg.pose.pose)});
+    publishMatches();
+  }
+
+  void publishMatches()
+  {
+    for (const GroundTruthMatcher::Match& m : matcher_.takeMatches())
+    {
+      ros::Time stamp;
+      stamp.fromNSec(static_cast<uint64_t>(m.stamp_ns));
+
+      geometry_msgs::TransformStamped tf;
+      tf.header.stamp = stamp + transform_tolerance_;
+      tf.header.frame_id = global_frame_;
+      tf.child_frame_id = odom_frame_;
+      tf.transform = toTransformMsg(m.map_odom);
+      broadcaster_.sendTransform(tf);
+
+      geometry_msgs::PoseWithCovarianceStamped pose;  // exact: the covariance stays zero
+      pose.header.stamp = stamp;
+      pose.header.frame_id = global_frame_;
+      pose.pose.pose = toPoseMsg(m.map_base);
+      pose_pub_.publish(pose);
+
+      geometry_msgs::PoseArray cloud;
+      cloud.header = pose.header;
+      cloud.poses.push_back(pose.pose.pose);
+      cloud_pub_.publish(cloud);
+    }
+  }
+
+  std::string global_frame_, odom_frame_, base_frame_;
+  ros::Duration transform_tolerance_;
+  GroundTruthMatcher matcher_;
+  tf2_ros::TransformBroadcaster broadcaster_;
+  ros::Publisher pose_pub_, cloud_pub_;
+  ros::Subscriber odom_sub_, truth_sub_;
+};
+
+}  // namespace localization
+}  // namespace mbot_navigation
+
+int main(int argc, char** argv)
+{
+  ros::init(argc, argv, "fake_localization");
+  ros::NodeHandle nh, pnh("~");
+  try
+  {
+    mbot_navigation::localization::FakeLocalizationNode node(nh, pnh);
+    ros::spin();
+  }
+  catch (const std::exception& e)
+  {
+    ROS_FATAL("fake_localization: %s", e.what());
+    return 1;
+  }
+  return 0;
+}

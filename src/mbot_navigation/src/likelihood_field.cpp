@@ -1,0 +1,136 @@
+#include "mbot_navigation/likelihood_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace mbot_navigation
+{
+namespace localization
+{
+namespace
+{
+/// "No obstacle" for the transform: large but finite, so that differences stay finite.
+constexpr double FAR = 1e20;
+
+/// One-dimensional squared distance transform (Felzenszwalb & Huttenlocher): d[q] is the lowest
+/// parabola (q - p)^2 + f[p] over all p. `v` and `z` hold the lower envelope of the parabolas.
+void transform1d(const std::vector<double>& f, std::vector<double>& d, std::vector<int>& v,
+                 std::vector<double>& z)
+{
+  const int n = static_cast<int>(f.size());
+  int k = 0;
+  v[0] = 0;
+  z[0] = -std::numeric_limits<double>::infinity();
+  z[1] = std::numeric_limits<double>::infinity();
+  for (int q = 1; q < n; ++q)
+  {
+    // where the parabola from q crosses the rightmost parabola of the envelope
+    double s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
+    while (s <= z[k])
+    {
+      --k;
+      s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q)
+  {
+    while (z[k + 1] < q) ++k;
+    const double dq = q - v[k];
+    d[q] = dq * dq + f[v[k]];
+  }
+}
+}  // namespace
+
+std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width,
+                                             unsigned height)
+{
+  std::vector<double> grid(occupied.size());
+  for (size_t i = 0; i < occupied.size(); ++i) grid[i] = occupied[i] ? 0.0 : FAR;
+
+  const unsigned longest = std::max(width, height);
+  std::vector<double> f(longest), d(longest), z(longest + 1);
+  std::vector<int> v(longest);
+
+  // pass 1: along every column (y), then pass 2: along every row (x) on the column result
+  f.resize(height);
+  d.resize(height);
+  for (unsigned x = 0; x < width; ++x)
+  {
+    for (unsigned y = 0; y < height; ++y) f[y] = grid[static_cast<size_t>(y) * width + x];
+    transform1d(f, d, v, z);
+    for (unsigned y = 0; y < height; ++y) grid[static_cast<size_t>(y) * width + x] = d[y];
+  }
+  f.resize(width);
+  d.resize(width);
+  for (unsigned y = 0; y < height; ++y)
+  {
+    const size_t row = static_cast<size_t>(y) * width;
+    for (unsigned x = 0; x < width; ++x) f[x] = grid[row + x];
+    transform1d(f, d, v, z);
+    for (unsigned x = 0; x < width; ++x) grid[row + x] = d[x];
+  }
+  return grid;
+}
+
+LikelihoodField::LikelihoodField(const OccupancyGridData& grid, double max_distance)
+  : width_(grid.width), height_(grid.height), resolution_(grid.resolution),
+    origin_x_(grid.origin_x), origin_y_(grid.origin_y), max_distance_(max_distance)
+{
+  const size_t cells = static_cast<size_t>(width_) * height_;
+  if (grid.data.size() != cells)
+    throw std::invalid_argument("likelihood field: the map is " + std::to_string(width_) + " x " +
+                                std::to_string(height_) + " cells but has " +
+                                std::to_string(grid.data.size()) + " values");
+  if (!(resolution_ > 0.0))
+    throw std::invalid_argument("likelihood field: resolution must be > 0, got " +
+                                std::to_string(resolution_));
+  if (!(max_distance_ > 0.0))
+    throw std::invalid_argument("likelihood field: laser_likelihood_max_dist must be > 0, got " +
+                                std::to_string(max_distance_));
+
+  std::vector<uint8_t> occupied(cells);
+  free_.resize(cells);
+  for (size_t i = 0; i < cells; ++i)
+  {
+    occupied[i] = grid.data[i] > 50 ? 1 : 0;
+    free_[i] = grid.data[i] == 0 ? 1 : 0;
+  }
+  const std::vector<double> squared = squaredDistanceTransform(occupied, width_, height_);
+  distance_.resize(cells);
+  for (size_t i = 0; i < cells; ++i)
+    distance_[i] = static_cast<float>(std::min(std::sqrt(squared[i]) * resolution_, max_distance_));
+}
+
+bool LikelihoodField::worldToMap(double x, double y, unsigned& mx, unsigned& my) const
+{
+  const double fx = std::floor((x - origin_x_) / resolution_);
+  const double fy = std::floor((y - origin_y_) / resolution_);
+  if (!(fx >= 0.0 && fy >= 0.0 && fx < width_ && fy < height_)) return false;  // also NaN
+  mx = static_cast<unsigned>(fx);
+  my = static_cast<unsigned>(fy);
+  return true;
+}
+
+double LikelihoodField::distance(double x, double y) const
+{
+  unsigned mx, my;
+  if (!worldToMap(x, y, mx, my)) return max_distance_;
+  return distance_[index(mx, my)];
+}
+
+bool LikelihoodField::isFree(double x, double y) const
+{
+  unsigned mx, my;
+  return worldToMap(x, y, mx, my) && free_[index(mx, my)] != 0;
+}
+
+}  // namespace localization
+}  // namespace mbot_navigation

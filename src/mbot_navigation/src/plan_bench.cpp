@@ -1,0 +1,270 @@
+/**
+ * @file plan_bench.cpp
+ * @brief Global planner benchmark on the shared inputs (/work/shared/bench/planner, see its
+ *        README): plan time p50/p95 [ms] and mean path length [cells] over the start/goal pairs.
+ *
+ *   plan_bench --map map_1000.pgm --pairs pairs_1000.csv [--planner astar] [--json]
+ *              [--cost-factor X] [--neutral-cost X] [--heuristic-weight X]
+ *              [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]
+ *
+ * The map is a raw cost PGM (P5, first row y = 0, no flip) read into a Costmap2D at 0.05 m/cell.
+ * Every pair is planned once after one warm-up plan; planning only, one thread, steady_clock.
+ * Each returned path is checked afterwards (not timed): it must start and end at the pair's cells
+ * and every pose must lie on a passable cell (cost < 253). The path length is the sum of the
+ * Euclidean segment lengths of the returned poses, in cells.
+ *
+ * Output: a text summary (also the thread's CPU time, which a busy machine inflates less than the
+ * wall time, and the cells A* expanded), and with --json one line
+ *   {"p50": ms, "p95": ms, "mean_path_cells": cells, "failures": n, "invalid_paths": n,
+ *    "cpu_p50": ms, "cpu_p95": ms}
+ * (p50/p95 are wall time). The A* flags override AStarConfig's defaults, for tuning.
+ * --verify-inflation re-inflates the map's lethal cells with InflationLayer (inscribed 0.15 m,
+ * inflation 0.55 m, factor 10, the inputs' README) and fails unless every cell matches.
+ * Exit status 0 only when every pair was planned and every path is valid.
+ */
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mbot_navigation/inflation_layer.h"
+#include "mbot_navigation/planner_factory.h"
+
+using namespace mbot_navigation;
+
+namespace
+{
+constexpr double kResolution = 0.05;  // [m/cell], from the inputs' README
+
+struct Pair
+{
+  int sx, sy, gx, gy;
+};
+
+/// Read one header token of a PGM, skipping whitespace and # comments.
+std::string pgmToken(std::istream& in)
+{
+  std::string tok;
+  while (true)
+  {
+    const int c = in.get();
+    if (c == EOF) break;
+    if (c == '#')
+    {
+      std::string line;
+      std::getline(in, line);
+      continue;
+    }
+    if (std::isspace(c))
+    {
+      if (!tok.empty()) break;
+      continue;
+    }
+    tok.push_back(static_cast<char>(c));
+  }
+  return tok;
+}
+
+Costmap2D readCostPgm(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read the file");
+  if (pgmToken(in) != "P5") throw std::runtime_error(path + ": expected a binary PGM (P5)");
+  const int w = std::stoi(pgmToken(in)), h = std::stoi(pgmToken(in)), maxval = std::stoi(pgmToken(in));
+  if (w <= 0 || h <= 0 || maxval != 255) throw std::runtime_error(path + ": expected maxval 255 and a size > 0");
+  Costmap2D map(w, h, kResolution, 0.0, 0.0);
+  in.read(reinterpret_cast<char*>(map.data()), static_cast<std::streamsize>(w) * h);
+  if (in.gcount() != static_cast<std::streamsize>(w) * h) throw std::runtime_error(path + ": truncated pixel data");
+  return map;  // first row of the file is y = 0: no flip
+}
+
+std::vector<Pair> readPairs(const std::string& path)
+{
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read the file");
+  std::string line;
+  std::getline(in, line);  // idx,sx,sy,gx,gy,euclid_cells
+  std::vector<Pair> pairs;
+  int row = 1;
+  while (std::getline(in, line))
+  {
+    ++row;
+    if (line.empty()) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream s(line);
+    int idx;
+    Pair p;
+    if (!(s >> idx >> p.sx >> p.sy >> p.gx >> p.gy))
+      throw std::runtime_error(path + ": line " + std::to_string(row) + ": expected idx,sx,sy,gx,gy,...");
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
+/// CPU time of this thread [ms] (wall time counts the other processes of a busy machine too).
+double threadCpuMs()
+{
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+double percentile(std::vector<double> v, double p)
+{
+  std::sort(v.begin(), v.end());
+  const size_t rank = static_cast<size_t>(std::ceil(p * v.size()));  // nearest rank
+  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+/// Re-inflate the map's lethal cells with InflationLayer and count the cells that differ.
+size_t verifyInflation(const Costmap2D& map)
+{
+  Costmap2D lethal(map.sizeX(), map.sizeY(), map.resolution(), 0.0, 0.0);
+  for (size_t i = 0; i < static_cast<size_t>(map.sizeX()) * map.sizeY(); ++i)
+    lethal.data()[i] = map.data()[i] == cost::LETHAL ? cost::LETHAL : cost::FREE;
+  InflationLayer inflation;  // defaults: 0.55 m, 10 /m
+  inflation.onFootprintChanged(0.15);
+  const auto t0 = std::chrono::steady_clock::now();
+  inflation.inflate(lethal);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  size_t diff = 0;
+  for (size_t i = 0; i < static_cast<size_t>(map.sizeX()) * map.sizeY(); ++i) diff += lethal.data()[i] != map.data()[i];
+  std::fprintf(stderr, "inflation check: %zu of %u cells differ from the input map (inflated in %.1f ms)\n", diff,
+               map.sizeX() * map.sizeY(), ms);
+  return diff;
+}
+
+[[noreturn]] void usage(const std::string& why)
+{
+  std::cerr << "plan_bench: " << why
+            << "\nusage: plan_bench --map FILE.pgm --pairs FILE.csv [--planner astar] [--json]\n"
+               "       [--cost-factor X] [--neutral-cost X] [--heuristic-weight X]\n"
+               "       [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]\n";
+  std::exit(2);
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  std::string map_path, pairs_path, planner_name = "astar";
+  bool json = false, verify = false;
+  GlobalPlannerParams params;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage(a + " needs a value");
+      return argv[++i];
+    };
+    auto number = [&]() {
+      const std::string v = value();
+      try
+      {
+        return std::stod(v);
+      }
+      catch (const std::exception&)
+      {
+        usage(a + " expects a number, got '" + v + "'");
+      }
+    };
+    if (a == "--map") map_path = value();
+    else if (a == "--pairs") pairs_path = value();
+    else if (a == "--planner") planner_name = value();
+    else if (a == "--json") json = true;
+    else if (a == "--verify-inflation") verify = true;
+    else if (a == "--cost-factor") params.astar.cost_factor = number();
+    else if (a == "--neutral-cost") params.astar.neutral_cost = number();
+    else if (a == "--heuristic-weight") params.astar.heuristic_weight = number();
+    else if (a == "--smoothing-tolerance") params.astar.smoothing_tolerance = number();
+    else if (a == "--no-smooth") params.astar.smooth_path = false;
+    else if (a == "--smoothing-passes") params.astar.smoothing_passes = static_cast<int>(number());
+    else usage("unknown argument '" + a + "'");
+  }
+  if (map_path.empty() || pairs_path.empty()) usage("--map and --pairs are required");
+
+  try
+  {
+    const Costmap2D map = readCostPgm(map_path);
+    const std::vector<Pair> pairs = readPairs(pairs_path);
+    if (pairs.empty()) throw std::runtime_error(pairs_path + ": no pairs");
+    if (verify && verifyInflation(map) != 0) return 1;
+    std::unique_ptr<GlobalPlanner> planner = makeGlobalPlanner(planner_name, params);
+
+    auto pose = [&](int x, int y) {
+      Pose2D p;
+      map.mapToWorld(x, y, p.x, p.y);
+      return p;
+    };
+    planner->makePlan(map, pose(pairs[0].sx, pairs[0].sy), pose(pairs[0].gx, pairs[0].gy));  // warm-up
+
+    std::vector<double> ms, cpu_ms, lengths, expanded;
+    int failures = 0, invalid = 0;
+    for (size_t k = 0; k < pairs.size(); ++k)
+    {
+      const Pair& p = pairs[k];
+      const Pose2D s = pose(p.sx, p.sy), g = pose(p.gx, p.gy);
+      const double c0 = threadCpuMs();
+      const auto t0 = std::chrono::steady_clock::now();
+      const PlanResult r = planner->makePlan(map, s, g);
+      const auto t1 = std::chrono::steady_clock::now();
+      cpu_ms.push_back(threadCpuMs() - c0);
+      ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      if (const auto* astar = dynamic_cast<const AStarPlanner*>(planner.get()))
+        expanded.push_back(static_cast<double>(astar->lastStats().expanded));
+      if (!r.ok)
+      {
+        ++failures;
+        std::fprintf(stderr, "pair %zu: %s\n", k, r.error.c_str());
+        continue;
+      }
+      double len = 0.0;
+      bool valid = std::hypot(r.path.front().x - s.x, r.path.front().y - s.y) < 1e-9 &&
+                   std::hypot(r.path.back().x - g.x, r.path.back().y - g.y) < 1e-9;
+      for (size_t i = 0; i < r.path.size(); ++i)
+      {
+        unsigned mx, my;
+        if (!map.worldToMap(r.path[i].x, r.path[i].y, mx, my) || map.cost(mx, my) >= cost::INSCRIBED) valid = false;
+        if (i > 0) len += std::hypot(r.path[i].x - r.path[i - 1].x, r.path[i].y - r.path[i - 1].y);
+      }
+      if (!valid)
+      {
+        ++invalid;
+        std::fprintf(stderr, "pair %zu: the path leaves the passable cells or misses an end\n", k);
+      }
+      lengths.push_back(len / kResolution);
+    }
+    double mean_len = 0.0;
+    for (double l : lengths) mean_len += l;
+    mean_len = lengths.empty() ? 0.0 : mean_len / lengths.size();
+    const double p50 = percentile(ms, 0.50), p95 = percentile(ms, 0.95);
+
+    std::printf("planner %s on %s: %zu pairs, p50 %.3f ms, p95 %.3f ms, max %.3f ms, mean path %.1f cells, "
+                "failures %d, invalid paths %d\n",
+                planner->name().c_str(), map_path.c_str(), pairs.size(), p50, p95, percentile(ms, 1.0), mean_len,
+                failures, invalid);
+    std::printf("  thread CPU time (less sensitive to a busy machine): p50 %.3f ms, p95 %.3f ms\n",
+                percentile(cpu_ms, 0.5), percentile(cpu_ms, 0.95));
+    if (!expanded.empty())
+      std::printf("  expanded cells: p50 %.0f, p95 %.0f\n", percentile(expanded, 0.5), percentile(expanded, 0.95));
+    if (json)
+      std::printf("{\"p50\": %.4f, \"p95\": %.4f, \"mean_path_cells\": %.2f, \"failures\": %d, \"invalid_paths\": %d, "
+                  "\"cpu_p50\": %.4f, \"cpu_p95\": %.4f}\n",
+                  p50, p95, mean_len, failures, invalid, percentile(cpu_ms, 0.5), percentile(cpu_ms, 0.95));
+    return (failures == 0 && invalid == 0) ? 0 : 1;
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "plan_bench: " << e.what() << "\n";
+    return 1;
+  }
+}

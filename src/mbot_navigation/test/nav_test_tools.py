@@ -1,0 +1,116 @@
+"""Helpers shared by the navigation rostests (test/nav_*.py): goals, the robot's ground-truth
+track, the simulator's contacts and the map. Everything waits in sim time; rostest's time-limit
+(wall time) catches a simulator that stopped."""
+import math
+import threading
+import time
+
+import actionlib
+import rospy
+from actionlib_msgs.msg import GoalStatus
+from mbot_msgs.msg import Contact
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+from nav_msgs.msg import OccupancyGrid, Odometry
+
+from mbot_navigation.grid_paths import grid_from_msg
+
+STATE_NAMES = {v: k for k, v in GoalStatus.__dict__.items() if k.isupper() and isinstance(v, int)}
+
+
+def state_name(state):
+    return STATE_NAMES.get(state, str(state))
+
+
+def make_goal(x, y, yaw=0.0, frame="map"):
+    """A MoveBaseGoal at (x, y) [m] facing `yaw` [rad] in `frame`."""
+    goal = MoveBaseGoal()
+    goal.target_pose.header.frame_id = frame
+    goal.target_pose.header.stamp = rospy.Time.now()
+    goal.target_pose.pose.position.x = x
+    goal.target_pose.pose.position.y = y
+    goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
+    goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
+    return goal
+
+
+def wait_until(condition, timeout, what):
+    """Poll `condition` every 0.05 s of sim time for up to `timeout` sim seconds."""
+    deadline = rospy.Time.now() + rospy.Duration(timeout)
+    while not rospy.is_shutdown() and rospy.Time.now() < deadline:
+        if condition():
+            return
+        rospy.sleep(0.05)
+    raise AssertionError("timed out after %.0f sim s waiting for %s" % (timeout, what))
+
+
+def action_client(robot, timeout=60.0):
+    """A connected SimpleActionClient for /<robot>/move_base (the server starts once the nav node
+    has the map and the robot's pose). Waits `timeout` wall seconds: the nodes start in wall time,
+    while the simulator may run much faster."""
+    client = actionlib.SimpleActionClient(robot + "/move_base", MoveBaseAction)
+    deadline = time.time() + timeout
+    while not client.wait_for_server(rospy.Duration(0.1)):
+        if time.time() > deadline or rospy.is_shutdown():
+            raise AssertionError("no action server /%s/move_base after %.0f s" % (robot, timeout))
+    return client
+
+
+def run_goal(client, goal, timeout):
+    """Send `goal`, wait up to `timeout` sim seconds; (state, status text, sim seconds taken)."""
+    start = rospy.Time.now()
+    client.send_goal(goal)
+    if not client.wait_for_result(rospy.Duration(timeout)):
+        client.cancel_goal()
+        client.wait_for_result(rospy.Duration(5.0))
+        return None, "no result within %.0f sim s" % timeout, (rospy.Time.now() - start).to_sec()
+    return client.get_state(), client.get_goal_status_text(), (rospy.Time.now() - start).to_sec()
+
+
+class Track(object):
+    """A robot's ground-truth pose (/<robot>/base_pose_ground_truth) and the distance it drove."""
+
+    def __init__(self, robot):
+        self._lock = threading.Lock()
+        self.pose = None       # (x, y, yaw)
+        self.length = 0.0      # [m] since reset()
+        self._sub = rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_odom, queue_size=50)
+
+    def _on_odom(self, msg):
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        with self._lock:
+            if self.pose is not None:
+                self.length += math.hypot(p.x - self.pose[0], p.y - self.pose[1])
+            self.pose = (p.x, p.y, yaw)
+
+    def reset(self):
+        with self._lock:
+            self.length = 0.0
+
+    def wait(self, timeout=60.0):
+        wait_until(lambda: self.pose is not None, timeout, "the robot's ground truth")
+        return self.pose
+
+
+class Contacts(object):
+    """Contacts that the simulator reports (/contacts) that involve one of `robots`."""
+
+    def __init__(self, robots):
+        self.robots = set(robots)
+        self.events = []
+        self._sub = rospy.Subscriber("/contacts", Contact, self._on_contact, queue_size=100)
+
+    def _on_contact(self, msg):
+        if msg.body_a in self.robots or msg.body_b in self.robots:
+            self.events.append("%s-%s at (%.2f, %.2f), t = %.2f" % (msg.body_a, msg.body_b, msg.position.x,
+                                                                   msg.position.y, msg.header.stamp.to_sec()))
+
+
+def wait_for_map(timeout=60.0):
+    """The map (/map, latched) as a grid_paths.Grid."""
+    msg = rospy.wait_for_message("/map", OccupancyGrid, timeout=timeout)
+    return grid_from_msg(msg)
+
+
+def angle_diff(a, b):
+    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))

@@ -1,0 +1,128 @@
+/**
+ * @file stage_ros.h
+ * @brief The ROS side of stage_node: reads the parameters once, builds the World from a world
+ *        file, owns sim time (/clock, real-time factor, pause), converts sensor samples to
+ *        messages and serves the run-time API. All simulation logic lives in World.
+ */
+#pragma once
+
+#include "mbot_sim/world.h"
+
+#include <geometry_msgs/Pose2D.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <mbot_msgs/RemoveRobot.h>
+#include <mbot_msgs/SetFault.h>
+#include <mbot_msgs/SpawnRobot.h>
+#include <mbot_msgs/TeleportRobot.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mbot_sim
+{
+/// @brief A startup problem (bad world file, missing parameter): main() prints it with
+///        ROS_FATAL as one line and exits non-zero.
+class StartupError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// @brief Parameters of stage_node, read once at startup.
+struct StageParams
+{
+  std::string world;               ///< ~world: a world name (maps/NAME.world.yaml) or a path
+  std::string maps_dir;            ///< ~maps_dir: where bare world names are looked up first
+  bool has_real_time_factor = false;
+  double real_time_factor = 1.0;   ///< ~real_time_factor: overrides the world file's when set
+  bool has_seed = false;
+  int seed = 0;                    ///< ~seed: overrides the world file's when set
+  double watchdog_timeout = 0.2;   ///< ~base_watchdog_timeout [s sim time]
+  double marker_rate = 10.0;       ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+};
+
+/// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
+StageParams readStageParams(const ros::NodeHandle& private_nh);
+
+/// @brief Find the world file for `world`: a path (contains '/' or ends in .yaml) as it is,
+///        else NAME.world.yaml in `maps_dir`, then in the workspace maps/ directory next to
+///        src/ (found from the mbot_sim package path), then in mbot_sim's share/maps.
+/// @throws StartupError naming the places searched
+std::string resolveWorldPath(const std::string& world, const std::string& maps_dir);
+
+/// @brief stage_node: one World, its topics, tf and services.
+class StageRos : public SensorListener
+{
+public:
+  /// @brief Load the world and advertise everything. @throws StartupError
+  StageRos(const ros::NodeHandle& nh, const StageParams& params);
+
+  /// @brief Step the world until shutdown, paced by the real-time factor (0: as fast as
+  ///        possible); callbacks and services are served between steps, on this thread.
+  void run();
+
+  // SensorListener: called by World::step()
+  void onOdometry(int robot, const OdometrySample& sample) override;
+  void onGroundTruth(int robot, const GroundTruthSample& sample) override;
+  void onJointState(int robot, const JointStateSample& sample) override;
+  void onScan(int robot, const ScanSample& sample) override;
+  void onContact(const ContactEvent& event) override;
+
+private:
+  /// Publishers, subscribers and reusable messages of one robot.
+  struct RobotIo
+  {
+    std::string name;
+    std::string prefix;  ///< "<name>/" for frame ids
+    ros::Publisher odom, ground_truth, scan, joint_states;
+    ros::Subscriber cmd_vel, cmd_pose;
+    nav_msgs::Odometry odom_msg, ground_truth_msg;
+    sensor_msgs::LaserScan scan_msg;
+    sensor_msgs::JointState joint_msg;
+    geometry_msgs::TransformStamped odom_tf;
+  };
+
+  const mbot_description::RobotModel& model(const std::string& name);
+  void addRobotIo(int robot);
+  void publishRobotList();
+  void publishMarkers();
+  void publishClock();
+
+  void onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg);
+  void onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg);
+  bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
+  bool onPause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
+  bool onUnpause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
+  bool onSpawn(mbot_msgs::SpawnRobot::Request& req, mbot_msgs::SpawnRobot::Response& res);
+  bool onRemove(mbot_msgs::RemoveRobot::Request& req, mbot_msgs::RemoveRobot::Response& res);
+  bool onTeleport(mbot_msgs::TeleportRobot::Request& req, mbot_msgs::TeleportRobot::Response& res);
+  bool onSetFault(mbot_msgs::SetFault::Request& req, mbot_msgs::SetFault::Response& res);
+
+  ros::NodeHandle nh_;
+  StageParams params_;
+  std::string description_dir_;  ///< mbot_description package path
+  std::map<std::string, mbot_description::RobotModel> models_;
+  std::unique_ptr<World> world_;
+  double real_time_factor_ = 1.0;
+  bool paused_ = false;
+  bool pacing_reset_ = true;  ///< re-anchor wall time to sim time (after start, pause, lag)
+
+  std::vector<std::unique_ptr<RobotIo>> io_;  ///< by robot id; nullptr for removed robots
+  ros::Publisher clock_pub_, contact_pub_, marker_pub_;
+  std::vector<ros::ServiceServer> services_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
+  double next_marker_time_ = 0.0;
+};
+
+}  // namespace mbot_sim

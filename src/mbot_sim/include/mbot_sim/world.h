@@ -1,0 +1,226 @@
+/**
+ * @file world.h
+ * @brief The simulated world, free of ROS: ODE rigid bodies in the plane (robots, static boxes
+ *        and cylinders, kinematic moving obstacles, the map walls as merged boxes), drive
+ *        kinematics with limits and a watchdog, contacts, odometry, lasers, noise and faults.
+ *
+ * One World owns sim time: step() advances it by the fixed physics step. Sensors keep their
+ * own update timers in sim time (flatland's UpdateTimer idea): after a step, every sensor that
+ * is due measures, and the sample (stamped with the sim time of the measurement) goes to the
+ * SensorListener, at once or, with a latency fault, a little later.
+ *
+ * Use:
+ * @code
+ *   World world(map, settings);
+ *   int id = world.addRobot("robot_0", model, {1.0, 2.0, 0.0});
+ *   world.setListener(&my_listener);
+ *   world.setCommand(id, {0.3, 0.0, 0.2});
+ *   for (int i = 0; i < 1000; ++i) world.step();
+ * @endcode
+ */
+#pragma once
+
+#include "mbot_sim/map_io.h"
+#include "mbot_sim/world_config.h"
+
+#include <mbot_description/robot_model.h>
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mbot_sim
+{
+/// @brief Raised by run-time requests that cannot be done (unknown robot, pose inside a wall,
+///        duplicate name...); the message says why. The world is unchanged when it is raised.
+class SimError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// @brief A planar velocity in the robot's frame.
+struct Twist2D
+{
+  double vx = 0.0;  ///< forward [m/s]
+  double vy = 0.0;  ///< left [m/s] (omni robots only)
+  double wz = 0.0;  ///< counter-clockwise [rad/s]
+};
+
+/// @brief Odometry: the pose in the robot's odom frame (identity at start and after a reset),
+///        integrated from the measured wheel motion, and the measured velocity in the robot frame.
+struct OdometrySample
+{
+  double stamp = 0.0;  ///< sim time of the measurement [s]
+  Pose2D pose;
+  Twist2D twist;
+};
+
+/// @brief The true pose in the map frame and the true velocity in the robot frame.
+struct GroundTruthSample
+{
+  double stamp = 0.0;  ///< [s]
+  Pose2D pose;
+  Twist2D twist;
+};
+
+/// @brief Wheel joint angles, in the order of RobotModel::wheel_joints.
+struct JointStateSample
+{
+  double stamp = 0.0;             ///< [s]
+  std::vector<double> position;   ///< [rad]
+  std::vector<double> velocity;   ///< [rad/s]
+};
+
+/// @brief One laser scan; beam i is at angle min_angle + i * angleIncrement() in the laser frame.
+struct ScanSample
+{
+  double stamp = 0.0;         ///< [s]
+  std::vector<float> ranges;  ///< [m]; +Inf: no return within range_max, -Inf: closer than range_min
+};
+
+/// @brief Two bodies started touching.
+struct ContactEvent
+{
+  double stamp = 0.0;  ///< sim time of the first step in which they touched [s]
+  std::string body_a;  ///< robot or obstacle name, or "map" for the walls
+  std::string body_b;
+  double x = 0.0;  ///< a contact point in the map frame [m]
+  double y = 0.0;
+};
+
+/// @brief An obstacle's shape and current pose (for markers).
+struct ObstacleState
+{
+  std::string name;
+  ShapeConfig shape;
+  Pose2D pose;
+  bool moving = false;
+};
+
+/// @brief Receives what the sensors measure and the contacts. World::step() calls these; a
+///        listener may call World::setCommand() from them, but must not add or remove robots.
+class SensorListener
+{
+public:
+  virtual ~SensorListener() = default;
+  virtual void onOdometry(int /*robot*/, const OdometrySample& /*sample*/) {}
+  virtual void onGroundTruth(int /*robot*/, const GroundTruthSample& /*sample*/) {}
+  virtual void onJointState(int /*robot*/, const JointStateSample& /*sample*/) {}
+  virtual void onScan(int /*robot*/, const ScanSample& /*sample*/) {}
+  virtual void onContact(const ContactEvent& /*event*/) {}
+};
+
+/// @brief Settings of a World that do not come from the bodies.
+struct WorldSettings
+{
+  double physics_step = 0.01;      ///< [s]
+  unsigned seed = 0;               ///< robot i draws its noise from std::mt19937(seed + i)
+  NoiseConfig noise;               ///< sensor noise of every robot
+  double watchdog_timeout = 0.2;   ///< [s] a robot with no command for this long stops
+  /// [m] robots collide this much before their footprints touch, so that a footprint never
+  /// enters a wall even in the step in which a contact begins (a fast robot moves 5 mm a step).
+  double contact_margin = 0.01;
+  /// [s] a pair of bodies counts as separated (and a new touch is reported again) only after
+  /// it has not touched for this long; stops flicker when a robot rests against a wall.
+  double contact_release = 0.05;
+};
+
+/// @brief The simulation. Robots are addressed by an id (stable while the robot exists; a
+///        removed robot's id is not reused) or by name.
+class World
+{
+public:
+  /// @param map the static walls: occupied cells (100) are merged into few rectangles
+  /// @throws SimError for a rotated map (origin yaw != 0) or a bad setting
+  World(const OccupancyMap& map, const WorldSettings& settings);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  // ---- bodies ------------------------------------------------------------------------------
+  /// @brief Add a robot at `pose` (map frame). Its start pose (for reset) is `pose`.
+  /// @throws SimError: duplicate name, invalid name, pose outside the map, overlapping a wall,
+  ///         an obstacle or a robot
+  int addRobot(const std::string& name, const mbot_description::RobotModel& model, const Pose2D& pose);
+  /// @throws SimError: unknown robot
+  void removeRobot(const std::string& name);
+  /// @throws SimError: duplicate name, overlapping a robot
+  void addObstacle(const ObstacleConfig& obstacle);
+  /// @throws SimError: duplicate name, fewer than 2 waypoints, speed <= 0
+  void addMovingObstacle(const MovingObstacleConfig& obstacle);
+
+  // ---- run-time requests -------------------------------------------------------------------
+  /// @brief The velocity the robot should drive (clamped to its limits, reached within its
+  ///        acceleration limits); it stops when no command comes for watchdog_timeout.
+  void setCommand(int robot, const Twist2D& command);
+  /// @brief Move a robot to `pose` at once, at rest; its odometry is not changed (as a kidnapping).
+  /// @throws SimError: unknown robot, pose outside the map or overlapping another body
+  void teleport(const std::string& name, const Pose2D& pose);
+  /// @brief Replace all faults of a robot (a default FaultConfig clears them).
+  /// @throws SimError: unknown robot, a value out of range
+  void setFaults(const std::string& name, const FaultConfig& faults);
+  /// @brief Every robot back to its start pose at rest with its odometry at identity; moving
+  ///        obstacles back to their first waypoint. Sim time goes on.
+  void resetPositions();
+
+  // ---- time --------------------------------------------------------------------------------
+  /// @brief The listener of sensor samples and contacts (not owned; nullptr: none).
+  void setListener(SensorListener* listener);
+  /// @brief Advance sim time by one physics step; then sensors that are due measure.
+  void step();
+  double time() const;          ///< sim time [s]
+  double physicsStep() const;   ///< [s]
+
+  // ---- queries -----------------------------------------------------------------------------
+  /// @return the robot's id, or -1 when there is no robot of that name
+  int findRobot(const std::string& name) const;
+  bool hasRobot(int robot) const;
+  std::vector<int> robotIds() const;  ///< in the order they were added
+  size_t robotCount() const;
+  const std::string& robotName(int robot) const;
+  const mbot_description::RobotModel& robotModel(int robot) const;
+  Pose2D groundTruth(int robot) const;    ///< true pose in the map frame
+  Twist2D velocity(int robot) const;      ///< true velocity in the robot frame
+  Pose2D odometry(int robot) const;       ///< current odometry pose (odom frame)
+  const FaultConfig& faults(int robot) const;
+  /// @brief True when a circle of `radius` [m] at (x, y) inside the map overlaps no wall,
+  ///        obstacle or robot.
+  bool isFree(double x, double y, double radius) const;
+  /// @brief Static and moving obstacles with their current poses.
+  std::vector<ObstacleState> obstacles() const;
+  /// @brief Number of rectangles the map walls were merged into.
+  size_t wallBoxCount() const;
+  /// @brief Laser beams cast since the world was made.
+  unsigned long long raysCast() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// @brief Loads a robot model by name (e.g. with mbot_description::loadRobotModel).
+using ModelLoader = std::function<mbot_description::RobotModel(const std::string& model)>;
+
+/// @brief Build the world a world file describes: map, obstacles, moving obstacles, robots,
+///        faults. Geometry errors name the file and the key, e.g.
+///        `office.world.yaml: robots[1].pose: robot_1 at (1.00, 2.00) overlaps a wall`.
+/// @throws WorldConfigError for a missing or invalid map, an unknown model, a body overlapping
+///         another
+std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& load_model,
+                                  double watchdog_timeout = 0.2);
+
+/// @brief The rectangles [cells] that cover exactly the occupied cells of `map` (greedy merge:
+///        grow each run of cells to the right, then down while the whole run is occupied).
+struct CellRect
+{
+  unsigned x = 0;  ///< first column
+  unsigned y = 0;  ///< first row
+  unsigned width = 0;
+  unsigned height = 0;
+};
+std::vector<CellRect> mergeOccupiedCells(const OccupancyMap& map);
+
+}  // namespace mbot_sim

@@ -1,0 +1,1 @@
+"""mbot_sim: Python helpers of the simulator (the simulator itself is the C++ stage_node)."""

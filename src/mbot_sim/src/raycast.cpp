@@ -1,0 +1,1046 @@
+/**
+ * @file raycast.cpp
+ * @brief Laser ray casting: grid walls by clearance-map stepping + exact cell walk, shapes by
+ *        an angular sweep over the beams each shape covers.
+ */
+#include "mbot_sim/raycast.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace mbot_sim
+{
+namespace
+{
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ----- clearance maps -----
+// Clearances are stored in quarter cells in one byte (0 .. 63.75 cells): a quarter cell lost to
+// rounding down costs little, and one byte per cell keeps a map in the CPU cache.
+constexpr double kClearanceUnit = 0.25;  // [cells] per stored unit
+constexpr unsigned kClearanceMaxUnits = 255;
+// Clearances are rounded down after subtracting this margin [cells], so that a long step
+// always ends strictly outside every wall despite rounding.
+constexpr double kClearanceMargin = 1e-3;
+// In the maps the ray tracing reads, a wall cell is marked 0 and a free cell is at least 1:
+// values below kMinLongStep never make a ray jump, so this costs nothing, and a cell walk then
+// reads one byte per cell to learn both "wall?" and "open space again?".
+constexpr uint8_t kWallCell = 0;
+
+// ----- ray tracing -----
+// A long step is taken when the clearance is at least this [units]. Exact clearances are
+// distances between cells (0, 1, sqrt(2), 2, ...), so 3 units = "not right next to a wall".
+constexpr unsigned kMinLongStep = 3;
+// While walking cell by cell, go back to long steps once a cell's clearance reaches this
+// [units] (3 cells): switching back costs about as much as walking a few cells, so short jumps
+// do not pay. (Measured: 7 to 28 units are within 10% of each other, in the benchmark room and
+// in a map of narrow corridors.)
+constexpr unsigned kResumeLongSteps = 12;
+// Long steps track the ray's position in fixed point, 32 integer + 32 fractional bits [cells].
+constexpr int kFixedShift = 32;
+constexpr double kFixedOne = 4294967296.0;  // 2^32
+
+/// pick ? a : b without a branch. For "did this beam hit?" a branch is mispredicted for about
+/// one beam in five, which costs more than this bit-mask select.
+template <typename Float, typename Bits>
+inline Float selectNoBranch(bool pick, Float a, Float b)
+{
+  static_assert(sizeof(Float) == sizeof(Bits), "Bits must be as wide as Float");
+  Bits ia;
+  Bits ib;
+  std::memcpy(&ia, &a, sizeof ia);
+  std::memcpy(&ib, &b, sizeof ib);
+  const Bits mask = Bits{ 0 } - static_cast<Bits>(pick);
+  const Bits bits = (ia & mask) | (ib & ~mask);
+  Float out;
+  std::memcpy(&out, &bits, sizeof out);
+  return out;
+}
+
+/// Squared 1D distance transform (Felzenszwalb & Huttenlocher, "Distance Transforms of Sampled
+/// Functions", 2012): d[q] = min_p (q - p)^2 + f[p], in O(n). v, z are scratch of size n, n + 1.
+void distanceTransform1d(const double* f, int n, double* d, int* v, double* z)
+{
+  int k = 0;
+  v[0] = 0;
+  z[0] = -kInf;
+  z[1] = kInf;
+  for (int q = 1; q < n; ++q)
+  {
+    double s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * (q - v[k]));
+    while (s <= z[k])
+    {
+      --k;
+      s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * (q - v[k]));
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = kInf;
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q)
+  {
+    while (z[k + 1] < q)
+      ++k;
+    d[q] = (double(q) - v[k]) * (double(q) - v[k]) + f[v[k]];
+  }
+}
+
+}  // namespace
+
+// =============================================================================================
+// GridRaycaster
+// =============================================================================================
+
+GridRaycaster::GridRaycaster(std::vector<uint8_t> occupied, unsigned size_x, unsigned size_y,
+                             double resolution, double origin_x, double origin_y)
+  : size_x_(size_x)
+  , size_y_(size_y)
+  , resolution_(resolution)
+  , inv_resolution_(1.0 / resolution)
+  , origin_x_(origin_x)
+  , origin_y_(origin_y)
+  , occupied_(std::move(occupied))
+{
+  if (!(resolution > 0.0))
+    throw std::invalid_argument("GridRaycaster: resolution must be > 0 [m], got " +
+                                std::to_string(resolution));
+  if (occupied_.size() != static_cast<size_t>(size_x) * size_y)
+    throw std::invalid_argument("GridRaycaster: occupied has " + std::to_string(occupied_.size()) +
+                                " cells, expected size_x * size_y = " + std::to_string(size_x) +
+                                " * " + std::to_string(size_y));
+  computeClearance();
+}
+
+// The clearance of a cell C is the smallest distance from ANY point of C to ANY occupied cell
+// (both are solid squares of side 1). For an occupied cell offset by (dx, dy) cells that
+// square-to-square distance is hypot(g(dx), g(dy)) with g(d) = max(|d| - 1, 0): neighbours,
+// diagonal ones included, touch C. (The centre-to-centre distance minus 1 is NOT safe: a
+// diagonal neighbour is sqrt(2) away centre to centre, yet touches C at a corner.)
+//
+// It is computed like a Euclidean distance transform, one axis at a time:
+// 1. along each line (row or column), the gap g to the nearest occupied cell of that line
+//    looking only ahead (increasing index) or only behind;
+// 2. across the lines, d^2(C) = min over cells O of the line gap at O plus g(offset across)^2,
+//    which is the 1D squared distance transform of Felzenszwalb & Huttenlocher once g is
+//    written as min(|offset - e|) for e in {-1, 0, 1}: a 3-wide min filter first.
+//
+// Quadrant maps: a ray heading right and up (dir_x >= 0, dir_y >= 0) from a point of cell C
+// only ever enters cells at or right of C's column and at or above C's row. So for it, the
+// clearance over the occupied cells at or right of C (a one-sided gap along rows), and the
+// one over the cells at or above C (one-sided along columns), are both safe jumps: it takes
+// the larger. A ray running beside a wall, or away from one, then jumps as if it were not there.
+namespace
+{
+enum class Look
+{
+  kAhead,   ///< only occupied cells at or after this one (increasing index)
+  kBehind,  ///< only at or before
+};
+
+constexpr double kFar = 1e20;  // "no occupied cell": finite, as the transform needs [cells^2]
+
+/// Step 1: per cell, g^2 of the gap to the nearest occupied cell of its line (rows when
+/// along_x, columns otherwise) looking one way, or kFar.
+std::vector<double> lineGaps(const std::vector<uint8_t>& occupied, int w, int h, bool along_x,
+                             Look look)
+{
+  std::vector<double> gap2(occupied.size(), kFar);
+  const int lines = along_x ? h : w;
+  const int len = along_x ? w : h;
+  auto at = [&](int line, int i) {
+    return along_x ? static_cast<size_t>(line) * w + i : static_cast<size_t>(i) * w + line;
+  };
+  auto store = [&](size_t idx, int cells_between) {
+    const double g = std::max(cells_between - 1, 0);
+    gap2[idx] = g * g;
+  };
+  for (int line = 0; line < lines; ++line)
+  {
+    if (look == Look::kAhead)
+      for (int i = len - 1, next = -1; i >= 0; --i)  // nearest occupied at or after i
+      {
+        if (occupied[at(line, i)])
+          next = i;
+        if (next >= 0)
+          store(at(line, i), next - i);
+      }
+    else
+      for (int i = 0, prev = -1; i < len; ++i)  // nearest occupied at or before i
+      {
+        if (occupied[at(line, i)])
+          prev = i;
+        if (prev >= 0)
+          store(at(line, i), i - prev);
+      }
+  }
+  return gap2;
+}
+
+/// Step 2: combine the line gaps across the lines (along columns when the gaps were taken
+/// along rows, and vice versa); d2 becomes the squared clearance [cells^2].
+void spreadAcrossLines(std::vector<double>& d2, int w, int h, bool gaps_along_x)
+{
+  const int lines = gaps_along_x ? w : h;  // we now run across: along columns for row gaps
+  const int len = gaps_along_x ? h : w;
+  std::vector<double> in(len), out(len), z(len + 1);
+  std::vector<int> v(len);
+  auto at = [&](int line, int i) {
+    return gaps_along_x ? static_cast<size_t>(i) * w + line : static_cast<size_t>(line) * w + i;
+  };
+  for (int line = 0; line < lines; ++line)
+  {
+    for (int i = 0; i < len; ++i)  // the 3-wide min filter
+    {
+      double m = d2[at(line, i)];
+      if (i > 0)
+        m = std::min(m, d2[at(line, i - 1)]);
+      if (i + 1 < len)
+        m = std::min(m, d2[at(line, i + 1)]);
+      in[i] = m;
+    }
+    distanceTransform1d(in.data(), len, out.data(), v.data(), z.data());
+    for (int i = 0; i < len; ++i)
+      d2[at(line, i)] = out[i];
+  }
+}
+
+/// Squared clearances [cells^2] -> stored map [quarter cells], rounded down after the margin.
+std::vector<uint8_t> quantizeClearance(const std::vector<double>& d2)
+{
+  std::vector<uint8_t> units(d2.size());
+  for (size_t i = 0; i < d2.size(); ++i)
+  {
+    const double u = std::floor((std::sqrt(d2[i]) - kClearanceMargin) / kClearanceUnit);
+    units[i] = static_cast<uint8_t>(std::clamp(u, 0.0, static_cast<double>(kClearanceMaxUnits)));
+  }
+  return units;
+}
+
+std::vector<uint8_t> clearanceMap(const std::vector<uint8_t>& occupied, int w, int h,
+                                  bool along_x, Look look)
+{
+  std::vector<double> d2 = lineGaps(occupied, w, h, along_x, look);
+  spreadAcrossLines(d2, w, h, along_x);
+  return quantizeClearance(d2);
+}
+}  // namespace
+
+void GridRaycaster::computeClearance()
+{
+  const int w = static_cast<int>(size_x_);
+  const int h = static_cast<int>(size_y_);
+  if (occupied_.empty())
+    return;  // an empty grid: every ray reads max range, no map needed
+  const std::vector<uint8_t> right = clearanceMap(occupied_, w, h, true, Look::kAhead);
+  const std::vector<uint8_t> left = clearanceMap(occupied_, w, h, true, Look::kBehind);
+  const std::vector<uint8_t> up = clearanceMap(occupied_, w, h, false, Look::kAhead);
+  const std::vector<uint8_t> down = clearanceMap(occupied_, w, h, false, Look::kBehind);
+  // Every occupied cell is at or right of C, or at or left of it: the nearest of all is the
+  // nearer of the two.
+  clearance_.resize(occupied_.size());
+  for (size_t i = 0; i < occupied_.size(); ++i)
+    clearance_[i] = std::min(right[i], left[i]);
+  const std::vector<uint8_t>* horizontal[4] = { &right, &left, &right, &left };  // bit 0: dir_x < 0
+  const std::vector<uint8_t>* vertical[4] = { &up, &up, &down, &down };         // bit 1: dir_y < 0
+  // The quadrant maps get a border of one free cell all around (stride w + 2), which lets the
+  // tracer skip bounds checks (see longSteps). A free cell is at least kWallCell + 1.
+  for (int q = 0; q < 4; ++q)
+  {
+    std::vector<uint8_t>& map = quadrant_clearance_[q];
+    map.assign(static_cast<size_t>(w + 2) * (h + 2), kWallCell + 1);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+      {
+        const size_t i = static_cast<size_t>(y) * w + x;
+        const uint8_t c = std::max((*horizontal[q])[i], (*vertical[q])[i]);
+        map[static_cast<size_t>(y + 1) * (w + 2) + x + 1] =
+            occupied_[i] ? kWallCell : std::max<uint8_t>(c, kWallCell + 1);
+      }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tracing rays through the cells
+//
+// A ray alternates between two modes:
+//
+// 1. Long steps ("sphere tracing"). The clearance c of the current cell says no wall the ray
+//    could meet is within c of any point of that cell, so the ray may jump c at once without
+//    missing a wall. In open space c is large and an 8 m ray needs only a few jumps;
+//    approaching a wall, c shrinks with the distance to it.
+// 2. Cell walk (Amanatides & Woo, "A Fast Voxel Traversal Algorithm", 1987). Right next to a
+//    wall the clearance is 0, so the ray visits the cells it crosses one by one, in order, and
+//    stops at the first occupied one. The distance returned is where the ray crosses that
+//    cell's boundary, computed from the ray's origin, so it is exact no matter how the ray got
+//    there. Once the walk reaches a cell far enough from the walls, it goes back to jumping.
+//
+// Units: cells. The grid is [0, w] x [0, h], cell (i, j) is [i, i+1] x [j, j+1], a ray is
+// p + t * u for t up to t_end: the max range, or where the ray leaves the grid if sooner.
+// ---------------------------------------------------------------------------------------------
+namespace
+{
+/// The maps the tracer reads: the quadrant clearance maps, walls marked kWallCell, each with a
+/// border of one free cell around the grid (see longSteps for why).
+struct CellMaps
+{
+  const uint8_t* quadrant_clearance[4];
+  int w;
+  int h;
+
+  /// Index of cell (cx, cy), for -1 <= cx <= w, -1 <= cy <= h (the border included).
+  size_t index(int64_t cx, int64_t cy) const
+  {
+    return static_cast<size_t>((cy + 1) * (w + 2) + cx + 1);
+  }
+  /// True for the grid and its border.
+  bool mapped(int cx, int cy) const
+  {
+    return static_cast<unsigned>(cx + 1) < static_cast<unsigned>(w + 2) &&
+           static_cast<unsigned>(cy + 1) < static_cast<unsigned>(h + 2);
+  }
+};
+
+/// A ray and its per-ray constants [cells].
+struct Ray
+{
+  double px, py;             ///< origin
+  double ux, uy;             ///< unit direction
+  double inv_ux, inv_uy;     ///< 1 / u (+-Inf for a zero component: never crosses on that axis)
+  double t_end;              ///< the max range, or where the ray leaves the grid if sooner
+  const uint8_t* clearance;  ///< the clearance map of the ray's direction quadrant
+};
+
+/// The ray p + t u, t <= t_max. p may be outside the grid (the caller then starts the ray
+/// where it enters); t_end is cut where the ray leaves the grid.
+inline Ray makeRay(const CellMaps& m, double px, double py, double ux, double uy, double t_max)
+{
+  const int quadrant = (ux < 0.0 ? 1 : 0) | (uy < 0.0 ? 2 : 0);
+  Ray r{ px, py, ux, uy, 1.0 / ux, 1.0 / uy, t_max, m.quadrant_clearance[quadrant] };
+  if (ux != 0.0)
+    r.t_end = std::min(r.t_end, ((ux > 0.0 ? m.w : 0) - px) * r.inv_ux);
+  if (uy != 0.0)
+    r.t_end = std::min(r.t_end, ((uy > 0.0 ? m.h : 0) - py) * r.inv_uy);
+  return r;
+}
+
+/// Where a ray is: at parameter t, in cell (cx, cy).
+struct RayPosition
+{
+  double t;
+  int cx, cy;
+  bool finished;  ///< reached t_end without a hit
+};
+
+/// The cell holding coordinate v [cells] of a point, or the cell just behind it when v is
+/// within rounding of a boundary (behind = against the direction component u). Rays must only
+/// be placed in their true cell or behind it: a cell ahead could make a quadrant map ignore a
+/// wall the ray can still meet, and would make the cell walk skip the true cell, whereas from
+/// a cell behind the walk simply crosses into the true one at once.
+inline int cellBehind(double v, double u)
+{
+  return static_cast<int>(std::floor(v - (u > 0.0 ? 1e-9 : u < 0.0 ? -1e-9 : 0.0)));
+}
+
+// Long steps track the ray's position in fixed point, 32 integer + 32 fractional bits [cells],
+// kept a little behind the true position (kFixedBehind): the rounding of the start and the
+// moves (truncated towards zero) then never puts it in a cell ahead of the ray, and it stays
+// far closer to the ray than the clearance margin.
+constexpr int64_t kFixedBehind = int64_t{ 1 } << 12;  // 2^-20 cells
+
+/// Long steps for N rays at once, each starting at its position in a cell whose clearance
+/// allows a long step. Afterwards every ray is either next to a wall (to be walked) or
+/// finished. Why N at once: each step needs the clearance of the cell the previous step landed
+/// in, so one ray is a chain of memory reads that each wait for the one before. Interleaving
+/// the steps of a few independent rays lets the processor overlap those waits; the loop
+/// exits (hard to predict) are also shared. For N = 1 this is the plain sphere-tracing loop.
+template <int N>
+void longSteps(const CellMaps& m, const Ray* rays, RayPosition* pos)
+{
+  // Position in fixed point: the cell of a point is a shift, not a float-to-int conversion,
+  // on the chain every step waits for. The distance travelled is counted in whole clearance
+  // units; past `limit` the ray is beyond t_end. Until then it is inside the grid, and its
+  // fixed-point position at worst a hair outside, in the maps' border, whose free cells stop
+  // the long steps: so no bounds checks are needed here.
+  int64_t fx[N], fy[N], move_x[N], move_y[N], units[N], limit[N];
+  double t0[N];
+  for (int k = 0; k < N; ++k)
+  {
+    const Ray& r = rays[k];
+    const unsigned c = r.clearance[m.index(pos[k].cx, pos[k].cy)];
+    t0[k] = pos[k].t + c * kClearanceUnit;  // the first jump, from anywhere in the start cell
+    limit[k] = t0[k] <= r.t_end ? static_cast<int64_t>((r.t_end - t0[k]) / kClearanceUnit) : -1;
+    move_x[k] = static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne);
+    move_y[k] = static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne);
+    fx[k] = static_cast<int64_t>((r.px + t0[k] * r.ux) * kFixedOne) -
+            (r.ux > 0.0 ? kFixedBehind : r.ux < 0.0 ? -kFixedBehind : 0);
+    fy[k] = static_cast<int64_t>((r.py + t0[k] * r.uy) * kFixedOne) -
+            (r.uy > 0.0 ? kFixedBehind : r.uy < 0.0 ? -kFixedBehind : 0);
+    units[k] = 0;
+  }
+  bool moving = true;
+  while (moving)
+  {
+    moving = false;
+    for (int k = 0; k < N; ++k)
+    {
+      if (units[k] > limit[k])
+        continue;  // past t_end: finished
+      const unsigned c = rays[k].clearance[m.index(fx[k] >> kFixedShift, fy[k] >> kFixedShift)];
+      if (c < kMinLongStep)
+        continue;  // next to a wall: stays here (and is just looked at again, which is cheap)
+      fx[k] += c * move_x[k];
+      fy[k] += c * move_y[k];
+      units[k] += c;
+      moving = true;
+    }
+  }
+  for (int k = 0; k < N; ++k)
+  {
+    pos[k].finished = units[k] > limit[k];
+    pos[k].t = t0[k] + units[k] * kClearanceUnit;
+    pos[k].cx = static_cast<int>(fx[k] >> kFixedShift);
+    pos[k].cy = static_cast<int>(fy[k] >> kFixedShift);
+  }
+}
+
+/// Trace one ray from its position (not in a wall; in the border at worst) to the end: the t
+/// of the first occupied cell's boundary, or t_end when there is none.
+inline double traceRay(const CellMaps& m, const Ray& r, RayPosition pos)
+{
+  const double delta_x = std::abs(r.inv_ux);  // t between two vertical boundaries
+  const double delta_y = std::abs(r.inv_uy);  // t between two horizontal boundaries
+  const int step_x = r.ux > 0.0 ? 1 : -1;
+  const int step_y = r.uy > 0.0 ? 1 : -1;
+  for (;;)
+  {
+    // ---- 1. long steps through open space
+    if (r.clearance[m.index(pos.cx, pos.cy)] >= kMinLongStep)
+    {
+      longSteps<1>(m, &r, &pos);
+      if (pos.finished)
+        return r.t_end;
+    }
+
+    // ---- 2. exact cell walk next to walls
+    double t = pos.t;
+    int cx = pos.cx;
+    int cy = pos.cy;
+    // Ray parameter of the next vertical (x) and horizontal (y) cell boundary.
+    double next_x = r.ux > 0.0 ? (cx + 1 - r.px) * r.inv_ux
+                    : r.ux < 0.0 ? (cx - r.px) * r.inv_ux
+                                 : kInf;
+    double next_y = r.uy > 0.0 ? (cy + 1 - r.py) * r.inv_uy
+                    : r.uy < 0.0 ? (cy - r.py) * r.inv_uy
+                                 : kInf;
+    // Placed a cell behind (see cellBehind), the ray is already past that boundary: move the
+    // cell up without moving t (for a ray almost parallel to the boundary, the crossing lies
+    // far back along the line).
+    if (next_x < t || next_y < t)
+    {
+      if (next_x < t)
+      {
+        cx += step_x;
+        next_x += delta_x;
+      }
+      if (next_y < t)
+      {
+        cy += step_y;
+        next_y += delta_y;
+      }
+      if (r.clearance[m.index(cx, cy)] == kWallCell)
+        return t;
+    }
+    for (;;)
+    {
+      // Cross into the next cell through whichever boundary comes first. Written as selects
+      // rather than if/else: the choice is close to random, so a branch would often be
+      // mispredicted, which costs more than computing both.
+      const bool cross_x = next_x < next_y;
+      t = cross_x ? next_x : next_y;
+      next_x += cross_x ? delta_x : 0.0;
+      next_y += cross_x ? 0.0 : delta_y;
+      cx += cross_x ? step_x : 0;
+      cy += cross_x ? 0 : step_y;
+      // Before t_end the ray is inside the grid, and the walk at worst one cell behind it, in
+      // the border; mapped() only guards against the impossible.
+      if (t >= r.t_end || !m.mapped(cx, cy))
+        return r.t_end;
+      const unsigned c = r.clearance[m.index(cx, cy)];
+      if (c == kWallCell)
+        return t;
+      if (c >= kResumeLongSteps)
+        break;  // open space again: back to long steps from this cell's entry point
+    }
+    pos = RayPosition{ t, cx, cy, false };
+  }
+}
+
+/// Trace N rays that start together at position `start` (the sensor's cell, not a wall): long
+/// steps in lockstep, then each ray finishes on its own (the walk, and any later long steps).
+template <int N>
+void traceGroup(const CellMaps& m, const Ray* rays, RayPosition start, double* t_hit)
+{
+  RayPosition pos[N];
+  bool jump = true;  // (near a wall some rays may not: then each ray goes on its own)
+  for (int k = 0; k < N; ++k)
+  {
+    pos[k] = start;
+    jump = jump && rays[k].clearance[m.index(start.cx, start.cy)] >= kMinLongStep;
+  }
+  if (jump)
+    longSteps<N>(m, rays, pos);
+  for (int k = 0; k < N; ++k)
+    t_hit[k] = pos[k].finished ? rays[k].t_end : traceRay(m, rays[k], pos[k]);
+}
+
+// Rays traced together by castFan (see longSteps): 4 measured best in the benchmark room.
+constexpr int kGroup = 4;
+}  // namespace
+
+double GridRaycaster::cast(double x, double y, double theta, double max_range) const
+{
+  return castDirection(x, y, std::cos(theta), std::sin(theta), max_range);
+}
+
+double GridRaycaster::castDirection(double x, double y, double dir_x, double dir_y,
+                                    double max_range) const
+{
+  double range = max_range;
+  castFan(x, y, &dir_x, &dir_y, 1, max_range, &range);
+  return range;
+}
+
+void GridRaycaster::castFan(double x, double y, const double* dir_x, const double* dir_y, int n,
+                            double max_range, double* ranges) const
+{
+  if (!(max_range > 0.0) || occupied_.empty() || !std::isfinite(x) || !std::isfinite(y))
+  {
+    std::fill(ranges, ranges + n, max_range);
+    return;
+  }
+  // Directions must be finite: they become cell indices.
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(dir_x[i]) || !std::isfinite(dir_y[i]))
+      throw std::invalid_argument("GridRaycaster: ray direction " + std::to_string(i) +
+                                  " is not finite");
+  const CellMaps maps{ { quadrant_clearance_[0].data(), quadrant_clearance_[1].data(),
+                         quadrant_clearance_[2].data(), quadrant_clearance_[3].data() },
+                       static_cast<int>(size_x_), static_cast<int>(size_y_) };
+  const double px = (x - origin_x_) * inv_resolution_;  // [cells]
+  const double py = (y - origin_y_) * inv_resolution_;
+  const double t_max = max_range * inv_resolution_;
+  auto toRange = [&](double t_hit, const Ray& r) {
+    return selectNoBranch<double, uint64_t>(t_hit < r.t_end, t_hit * resolution_, max_range);
+  };
+
+  int i = 0;
+  if (px >= 0.0 && py >= 0.0 && px < maps.w && py < maps.h)
+  {
+    // The usual case, a sensor inside the grid: whole groups of beams, then the rest.
+    const RayPosition start{ 0.0, static_cast<int>(px), static_cast<int>(py), false };
+    if (occupied_[static_cast<size_t>(start.cy) * size_x_ + start.cx])
+    {
+      std::fill(ranges, ranges + n, 0.0);  // the sensor is inside a wall
+      return;
+    }
+    for (; i + kGroup <= n; i += kGroup)
+    {
+      Ray rays[kGroup];
+      double t_hit[kGroup];
+      for (int k = 0; k < kGroup; ++k)
+        rays[k] = makeRay(maps, px, py, dir_x[i + k], dir_y[i + k], t_max);
+      traceGroup<kGroup>(maps, rays, start, t_hit);
+      for (int k = 0; k < kGroup; ++k)
+        ranges[i + k] = toRange(t_hit[k], rays[k]);
+    }
+    for (; i < n; ++i)
+    {
+      const Ray r = makeRay(maps, px, py, dir_x[i], dir_y[i], t_max);
+      ranges[i] = toRange(traceRay(maps, r, start), r);
+    }
+    return;
+  }
+  // A sensor outside the grid (which counts as free): a ray starts where it enters the grid.
+  for (; i < n; ++i)
+  {
+    const Ray r = makeRay(maps, px, py, dir_x[i], dir_y[i], t_max);
+    // The entry: the last of the two slab entries (a zero component never leaves its slab).
+    double t_start = 0.0;
+    if (r.ux != 0.0)
+      t_start = std::max(t_start, ((r.ux > 0.0 ? 0 : maps.w) - px) * r.inv_ux);
+    else if (px < 0.0 || px > maps.w)
+      t_start = kInf;
+    if (r.uy != 0.0)
+      t_start = std::max(t_start, ((r.uy > 0.0 ? 0 : maps.h) - py) * r.inv_uy);
+    else if (py < 0.0 || py > maps.h)
+      t_start = kInf;
+    if (!(t_start <= r.t_end))
+    {
+      ranges[i] = max_range;  // misses the grid, or enters it beyond max range
+      continue;
+    }
+    // The entry point lies on the grid's edge: its cell "behind" is the border cell outside,
+    // a free cell from which the walk crosses into the grid at t_start, where a wall cell is
+    // hit at once.
+    const RayPosition start{ t_start,
+                             std::clamp(cellBehind(px + t_start * r.ux, r.ux), -1, maps.w),
+                             std::clamp(cellBehind(py + t_start * r.uy, r.uy), -1, maps.h), false };
+    ranges[i] = toRange(traceRay(maps, r, start), r);
+  }
+}
+
+bool GridRaycaster::occupiedAt(double x, double y) const
+{
+  const double fx = std::floor((x - origin_x_) * inv_resolution_);
+  const double fy = std::floor((y - origin_y_) * inv_resolution_);
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
+    return false;
+  return occupied_[static_cast<size_t>(fy) * size_x_ + static_cast<size_t>(fx)] != 0;
+}
+
+double GridRaycaster::clearanceAt(double x, double y) const
+{
+  const double fx = std::floor((x - origin_x_) * inv_resolution_);
+  const double fy = std::floor((y - origin_y_) * inv_resolution_);
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
+    return 0.0;
+  const size_t idx = static_cast<size_t>(fy) * size_x_ + static_cast<size_t>(fx);
+  return clearance_[idx] * kClearanceUnit * resolution_;
+}
+
+double GridRaycaster::clearanceAlong(double x, double y, double dir_x, double dir_y) const
+{
+  const double fx = std::floor((x - origin_x_) * inv_resolution_);
+  const double fy = std::floor((y - origin_y_) * inv_resolution_);
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
+    return 0.0;
+  const size_t idx = (static_cast<size_t>(fy) + 1) * (size_x_ + 2) + static_cast<size_t>(fx) + 1;
+  const int quadrant = (dir_x < 0.0 ? 1 : 0) | (dir_y < 0.0 ? 2 : 0);
+  const unsigned c = quadrant_clearance_[quadrant][idx];
+  return c < kMinLongStep ? 0.0 : c * kClearanceUnit * resolution_;  // (1, 2: free, next to a wall)
+}
+
+// =============================================================================================
+// ShapeSet
+// =============================================================================================
+
+ShapeSet::ShapeSet(double bucket_size) : bucket_size_(bucket_size)
+{
+  if (!(bucket_size > 0.0))
+    throw std::invalid_argument("ShapeSet: bucket_size must be > 0 [m], got " +
+                                std::to_string(bucket_size));
+}
+
+void ShapeSet::clear()
+{
+  for (auto& kv : buckets_)
+  {
+    kv.second.circles.clear();
+    kv.second.boxes.clear();
+  }
+  count_ = 0;
+  max_extent_ = 0.0;
+}
+
+int64_t ShapeSet::bucketIndex(double v) const
+{
+  return static_cast<int64_t>(std::floor(v / bucket_size_));
+}
+
+namespace
+{
+inline int64_t packBucketKey(int64_t bx, int64_t by)
+{
+  return (bx << 32) ^ (by & 0xffffffffLL);
+}
+}  // namespace
+
+ShapeSet::Bucket& ShapeSet::bucketAt(double x, double y)
+{
+  return buckets_[packBucketKey(bucketIndex(x), bucketIndex(y))];
+}
+
+const ShapeSet::Bucket* ShapeSet::findBucket(int64_t bx, int64_t by) const
+{
+  const auto it = buckets_.find(packBucketKey(bx, by));
+  return it == buckets_.end() ? nullptr : &it->second;
+}
+
+void ShapeSet::addCircle(const Circle& c)
+{
+  if (!std::isfinite(c.x) || !std::isfinite(c.y) || !(c.radius >= 0.0) || !std::isfinite(c.radius))
+    throw std::invalid_argument("ShapeSet::addCircle: x, y must be finite and radius >= 0 [m]");
+  bucketAt(c.x, c.y).circles.push_back(c);
+  max_extent_ = std::max(max_extent_, c.radius);
+  ++count_;
+}
+
+void ShapeSet::addBox(const OrientedBox& b)
+{
+  if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.yaw) ||
+      !(b.half_length >= 0.0) || !(b.half_width >= 0.0) || !std::isfinite(b.half_length) ||
+      !std::isfinite(b.half_width))
+    throw std::invalid_argument(
+        "ShapeSet::addBox: x, y, yaw must be finite and half sizes >= 0 [m]");
+  PreparedBox p;
+  p.box = b;
+  p.cos_yaw = std::cos(b.yaw);
+  p.sin_yaw = std::sin(b.yaw);
+  bucketAt(b.x, b.y).boxes.push_back(p);
+  max_extent_ = std::max(max_extent_, std::hypot(b.half_length, b.half_width));
+  ++count_;
+}
+
+size_t ShapeSet::size() const
+{
+  return count_;
+}
+
+// =============================================================================================
+// castScan
+// =============================================================================================
+
+namespace
+{
+inline int floorToInt(double v)
+{
+  const int i = static_cast<int>(v);  // truncates towards zero
+  return i - (v < i ? 1 : 0);
+}
+
+inline int ceilToInt(double v)
+{
+  const int i = static_cast<int>(v);
+  return i + (v > i ? 1 : 0);
+}
+
+// Error bound of approxAtan2 [rad] (the polynomial's is 2.5e-7), with room for rounding.
+constexpr double kApproxAtan2Error = 1e-6;
+
+/// atan2(y, x) [rad] within kApproxAtan2Error, several times cheaper than std::atan2. Used only
+/// to choose which beams a shape may cover: intervals are widened by the error, and every
+/// chosen beam gets the exact intersection test.
+inline double approxAtan2(double y, double x)
+{
+  const double ax = std::abs(x);
+  const double ay = std::abs(y);
+  const double big = std::max(ax, ay);
+  const double a = big > 0.0 ? std::min(ax, ay) / big : 0.0;  // in [0, 1]
+  const double s = a * a;
+  // Minimax fit of atan(a) / a as a polynomial in a^2 on [0, 1].
+  double r = 0.0068119531;
+  r = r * s - 0.0336046959;
+  r = r * s + 0.0796242110;
+  r = r * s - 0.1323337105;
+  r = r * s + 0.1980782302;
+  r = r * s - 0.3331736886;
+  r = (r * s + 0.9999961118) * a;
+  r = ay > ax ? 0.5 * kPi - r : r;
+  r = x < 0.0 ? kPi - r : r;
+  return y < 0.0 ? -r : r;
+}
+
+/// The beams of a scan as angles: beam i points along first + i * increment [rad].
+struct BeamFan
+{
+  double first;     ///< angle of beam 0 [rad]
+  double sign;      ///< +1: beams advance counter-clockwise; -1: clockwise
+  double step;      ///< |increment| [rad]
+  double inv_step;  ///< [1/rad]
+  double span;      ///< (beams - 1) * step [rad]
+  int beams;
+  bool parallel;  ///< increment ~ 0: every beam points the same way
+
+  BeamFan(double first_angle, double increment, int n)
+    : first(std::remainder(first_angle, kTwoPi))  // into [-pi, pi]: keeps the sweep's winding small
+    , sign(increment < 0.0 ? -1.0 : 1.0)
+    , step(std::abs(increment))
+    , inv_step(step > 0.0 ? 1.0 / step : 0.0)
+    , span((n - 1) * step)
+    , beams(n)
+    , parallel(step < 1e-12)
+  {
+  }
+};
+
+/// Calls visit(i) for every beam i whose angle lies in [lo, hi] (world angles [rad], any
+/// winding, hi - lo <= pi). This is the angular sweep: a shape covering a few degrees costs a
+/// few beam tests, not one per beam of the scan. A beam may be visited twice when the fan spans
+/// more than a full turn; visitors keep the nearest return, so that is harmless.
+template <typename Visit>
+void forEachBeamBetween(const BeamFan& fan, double lo, double hi, Visit&& visit)
+{
+  if (fan.parallel)
+  {
+    for (int i = 0; i < fan.beams; ++i)  // let the exact test decide for every beam
+      visit(i);
+    return;
+  }
+  // Angles relative to beam 0, measured in the direction the beams advance.
+  double a = (lo - fan.first) * fan.sign;
+  double b = (hi - fan.first) * fan.sign;
+  if (a > b)
+    std::swap(a, b);
+  const double turns = floorToInt(a * (1.0 / kTwoPi));  // wind a into [0, 2 pi)
+  a -= turns * kTwoPi;
+  b -= turns * kTwoPi;
+  // The interval, its copy one turn earlier (for an interval straddling beam 0), and later
+  // copies for fans longer than a turn.
+  for (double shift = -kTwoPi; a + shift <= fan.span; shift += kTwoPi)
+  {
+    const double hi_i = std::min((b + shift) * fan.inv_step, fan.beams - 1.0);
+    if (hi_i < 0.0)
+      continue;
+    const double lo_i = (a + shift) * fan.inv_step;
+    const int i0 = lo_i <= 0.0 ? 0 : ceilToInt(lo_i);
+    const int i1 = floorToInt(hi_i);
+    for (int i = i0; i <= i1; ++i)
+      visit(i);
+  }
+}
+
+/// Beam directions relative to the sensor heading, cos/sin of min_angle + i * increment. A
+/// laser's layout never changes, so they are computed once and only rotated by the yaw.
+struct BeamLayout
+{
+  double min_angle = 0.0;
+  double increment = 0.0;
+  std::vector<double> rel_cos;
+  std::vector<double> rel_sin;
+
+  bool matches(const ScanSpec& spec) const
+  {
+    return rel_cos.size() == static_cast<size_t>(spec.beams) && min_angle == spec.min_angle &&
+           increment == spec.angle_increment;
+  }
+};
+
+/// Reused between calls (per thread) so that a scan allocates nothing and computes no cos/sin.
+struct ScanScratch
+{
+  std::vector<BeamLayout> layouts;  ///< the few laser layouts of the fleet's models
+  size_t next_to_replace = 0;
+  std::vector<double> dir_x;  ///< world beam directions of the current scan
+  std::vector<double> dir_y;
+  std::vector<double> range;  ///< nearest return so far per beam [m]
+
+  const BeamLayout& layout(const ScanSpec& spec)
+  {
+    for (const BeamLayout& l : layouts)
+      if (l.matches(spec))
+        return l;
+    constexpr size_t kMaxLayouts = 8;  // beyond that, replace them in turn
+    if (layouts.size() < kMaxLayouts)
+      layouts.emplace_back();
+    else
+      std::swap(layouts[next_to_replace++ % kMaxLayouts], layouts.back());
+    BeamLayout& l = layouts.back();
+    l.min_angle = spec.min_angle;
+    l.increment = spec.angle_increment;
+    l.rel_cos.resize(spec.beams);
+    l.rel_sin.resize(spec.beams);
+    for (int i = 0; i < spec.beams; ++i)
+    {
+      l.rel_cos[i] = std::cos(spec.min_angle + i * spec.angle_increment);
+      l.rel_sin[i] = std::sin(spec.min_angle + i * spec.angle_increment);
+    }
+    return l;
+  }
+};
+
+/// What the shape sweeps need to know about the scan being cast.
+struct ScanView
+{
+  double sx, sy;  ///< sensor position [m]
+  double range_max;
+  const BeamFan& fan;
+  const double* dir_x;
+  const double* dir_y;
+  double* range;  ///< per beam, nearest return so far [m]
+
+  void sensorInsideShape() const { std::fill(range, range + fan.beams, 0.0); }
+};
+
+/// Shorten the beams that hit circle c.
+void sweepCircle(const ScanView& scan, const Circle& c)
+{
+  const double mx = c.x - scan.sx;  // sensor -> centre
+  const double my = c.y - scan.sy;
+  const double d2 = mx * mx + my * my;
+  const double r2 = c.radius * c.radius;
+  if (d2 <= r2)
+    return scan.sensorInsideShape();
+  const double d = std::sqrt(d2);
+  const double nearest = d - c.radius;  // no beam can meet the circle closer than this
+  if (nearest >= scan.range_max)
+    return;
+  // Seen from the sensor the circle covers bearing +- asin(r / d). r / sqrt(d^2 - r^2) (the
+  // tangent of that angle) is a little wider and needs no asin: fine, since every beam in
+  // the interval gets the exact test. (Capped at pi/2, which asin never exceeds.)
+  const double half = std::min(c.radius / std::sqrt(d2 - r2), 0.5 * kPi) + kApproxAtan2Error;
+  const double bearing = approxAtan2(my, mx);
+  forEachBeamBetween(scan.fan, bearing - half, bearing + half, [&](int i) {
+    if (nearest >= scan.range[i])
+      return;  // this beam already has a closer return (a wall or another shape)
+    // Ray-circle: closest approach at b along the beam; the entry lies sqrt(disc) before it.
+    const double b = mx * scan.dir_x[i] + my * scan.dir_y[i];
+    const double disc = b * b - (d2 - r2);
+    if (disc < 0.0 || b < 0.0)
+      return;
+    scan.range[i] = std::min(scan.range[i], b - std::sqrt(disc));
+  });
+}
+
+/// Ray from local point (lx, ly) along local unit (ux, uy) against the box |x| <= hl, |y| <= hw
+/// (slab test): distance to the entry point, or +Inf. The ray starts outside the box.
+inline double rayBox(double lx, double ly, double ux, double uy, double hl, double hw)
+{
+  double t_in = 0.0;
+  double t_out = kInf;
+  const double p[2] = { lx, ly };
+  const double u[2] = { ux, uy };
+  const double half[2] = { hl, hw };
+  for (int a = 0; a < 2; ++a)
+  {
+    if (u[a] == 0.0)
+    {
+      if (std::abs(p[a]) > half[a])
+        return kInf;
+      continue;
+    }
+    double t0 = (-half[a] - p[a]) / u[a];
+    double t1 = (half[a] - p[a]) / u[a];
+    if (t0 > t1)
+      std::swap(t0, t1);
+    t_in = std::max(t_in, t0);
+    t_out = std::min(t_out, t1);
+  }
+  return t_in <= t_out ? t_in : kInf;
+}
+
+/// Shorten the beams that hit box b (with cos_yaw, sin_yaw of its yaw).
+void sweepBox(const ScanView& scan, const OrientedBox& b, double cos_yaw, double sin_yaw)
+{
+  const double mx = b.x - scan.sx;  // sensor -> centre
+  const double my = b.y - scan.sy;
+  // The sensor in the box frame.
+  const double lx = -(cos_yaw * mx + sin_yaw * my);
+  const double ly = -(-sin_yaw * mx + cos_yaw * my);
+  const double gap_x = std::abs(lx) - b.half_length;
+  const double gap_y = std::abs(ly) - b.half_width;
+  if (gap_x <= 0.0 && gap_y <= 0.0)
+    return scan.sensorInsideShape();
+  const double nearest = std::hypot(std::max(gap_x, 0.0), std::max(gap_y, 0.0));
+  if (nearest >= scan.range_max)
+    return;
+  // The box covers the bearings between its extreme corners. The sensor is outside the
+  // (convex) box, so that cone is narrower than pi and contains the centre's bearing: measure
+  // the corners' bearings relative to the centre's and take the smallest and largest.
+  double lo = 0.0;
+  double hi = 0.0;
+  for (int k = 0; k < 4; ++k)
+  {
+    const double cl = (k & 1) ? b.half_length : -b.half_length;
+    const double cw = (k & 2) ? b.half_width : -b.half_width;
+    const double vx = mx + cos_yaw * cl - sin_yaw * cw;  // sensor -> corner
+    const double vy = my + sin_yaw * cl + cos_yaw * cw;
+    const double rel = approxAtan2(mx * vy - my * vx, mx * vx + my * vy);
+    lo = std::min(lo, rel);
+    hi = std::max(hi, rel);
+  }
+  const double bearing = approxAtan2(my, mx);
+  const double pad = 2.0 * kApproxAtan2Error;
+  forEachBeamBetween(scan.fan, bearing + lo - pad, bearing + hi + pad, [&](int i) {
+    if (nearest >= scan.range[i])
+      return;
+    const double ux = cos_yaw * scan.dir_x[i] + sin_yaw * scan.dir_y[i];  // beam in box frame
+    const double uy = -sin_yaw * scan.dir_x[i] + cos_yaw * scan.dir_y[i];
+    scan.range[i] = std::min(scan.range[i], rayBox(lx, ly, ux, uy, b.half_length, b.half_width));
+  });
+}
+}  // namespace
+
+void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec& spec,
+              std::vector<float>& ranges)
+{
+  if (spec.beams < 0)
+    throw std::invalid_argument("castScan: beams must be >= 0, got " + std::to_string(spec.beams));
+  if (!(spec.range_max > 0.0))
+    throw std::invalid_argument("castScan: range_max must be > 0 [m], got " +
+                                std::to_string(spec.range_max));
+  if (!std::isfinite(spec.x) || !std::isfinite(spec.y) || !std::isfinite(spec.yaw) ||
+      !std::isfinite(spec.min_angle) || !std::isfinite(spec.angle_increment))
+    throw std::invalid_argument("castScan: x, y, yaw, min_angle and angle_increment must be "
+                                "finite");
+  const int n = spec.beams;
+  ranges.resize(n);
+  if (n == 0)
+    return;
+
+  // ---- beam directions
+  thread_local ScanScratch scratch;
+  const BeamLayout& layout = scratch.layout(spec);
+  scratch.dir_x.resize(n);
+  scratch.dir_y.resize(n);
+  scratch.range.resize(n);
+  const double cos_yaw = std::cos(spec.yaw);
+  const double sin_yaw = std::sin(spec.yaw);
+  for (int i = 0; i < n; ++i)
+  {
+    scratch.dir_x[i] = cos_yaw * layout.rel_cos[i] - sin_yaw * layout.rel_sin[i];
+    scratch.dir_y[i] = sin_yaw * layout.rel_cos[i] + cos_yaw * layout.rel_sin[i];
+  }
+  const BeamFan fan(spec.yaw + spec.min_angle, spec.angle_increment, n);
+  const ScanView scan{ spec.x, spec.y, spec.range_max, fan,
+                       scratch.dir_x.data(), scratch.dir_y.data(), scratch.range.data() };
+
+  // ---- walls first: every beam gets its grid range (range_max when it hits nothing).
+  grid.castFan(spec.x, spec.y, scan.dir_x, scan.dir_y, n, spec.range_max, scan.range);
+
+  // ---- then shapes: each one can only shorten the beams inside the angle it covers.
+  // Shapes are bucketed by centre, so look at buckets up to range_max + the largest shape
+  // extent away: a shape whose centre is farther cannot reach any beam.
+  auto ignored = [&](int owner) { return spec.ignore_owner >= 0 && owner == spec.ignore_owner; };
+  const double reach = spec.range_max + shapes.max_extent_;
+  const int64_t bx0 = shapes.bucketIndex(spec.x - reach);
+  const int64_t bx1 = shapes.bucketIndex(spec.x + reach);
+  const int64_t by0 = shapes.bucketIndex(spec.y - reach);
+  const int64_t by1 = shapes.bucketIndex(spec.y + reach);
+  for (int64_t by = by0; by <= by1 && shapes.count_ > 0; ++by)
+  {
+    for (int64_t bx = bx0; bx <= bx1; ++bx)
+    {
+      const ShapeSet::Bucket* bucket = shapes.findBucket(bx, by);
+      if (bucket == nullptr)
+        continue;
+      for (const Circle& c : bucket->circles)
+        if (!ignored(c.owner))
+          sweepCircle(scan, c);
+      for (const ShapeSet::PreparedBox& pb : bucket->boxes)
+        if (!ignored(pb.box.owner))
+          sweepBox(scan, pb.box, pb.cos_yaw, pb.sin_yaw);
+    }
+  }
+
+  // ---- REP-117 encoding.
+  const float inf = std::numeric_limits<float>::infinity();
+  const double range_min = spec.range_min;
+  const double range_max = spec.range_max;
+  float* out = ranges.data();
+  for (int i = 0; i < n; ++i)
+  {
+    const double r = scan.range[i];
+    const float near = selectNoBranch<float, uint32_t>(r < range_min, -inf, static_cast<float>(r));
+    out[i] = selectNoBranch<float, uint32_t>(r >= range_max, inf, near);
+  }
+}
+
+}  // namespace mbot_sim

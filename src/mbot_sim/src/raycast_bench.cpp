@@ -1,0 +1,303 @@
+/**
+ * @file raycast_bench.cpp
+ * @brief Ray casting benchmark: 360-beam, 8 m scans from random free poses (seeded) in a
+ *        20 x 20 m room (0.05 m cells, outer walls and a few interior walls) with 10 robots
+ *        (circles, r = 0.15 m) moving around; then the same room tiled 3 x 3 (60 x 60 m) with
+ *        1000 robots. Prints one JSON line:
+ *        {"rays_per_second": X, "beams": 360, "range_max": 8.0, ...}
+ *
+ * Each frame moves the robots, rebuilds the ShapeSet (timed) and casts 10 scans (room) or 100
+ * scans (1000 robots: their 10 Hz lasers over one 100 Hz physics step) (timed). Besides
+ * "rays_per_second" (wall time, std::chrono::steady_clock), "cpu_rays_per_second" uses the
+ * process CPU time: on a machine busy with other work it shows the speed of the code itself.
+ *
+ *   raycast_bench [--seconds S]   S: timed work per scenario [s], default 2 (at least 1)
+ */
+#include "mbot_sim/raycast.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace
+{
+using mbot_sim::Circle;
+using mbot_sim::GridRaycaster;
+using mbot_sim::ScanSpec;
+using mbot_sim::ShapeSet;
+
+constexpr double kResolution = 0.05;  // [m]
+constexpr double kRoomSize = 20.0;    // [m]
+constexpr double kWall = 0.1;         // wall thickness [m]
+constexpr double kRobotRadius = 0.15;  // [m]
+constexpr int kBeams = 360;
+constexpr double kRangeMax = 8.0;  // [m]
+constexpr double kSpeed = 0.5;     // robot speed [m/s]
+constexpr double kFrameDt = 0.1;   // sim time between shape rebuilds [s] (a 10 Hz laser)
+
+/// An occupancy grid being drawn, in metres.
+struct Canvas
+{
+  unsigned size_x;
+  unsigned size_y;
+  std::vector<uint8_t> cells;
+
+  Canvas(double width, double height)
+    : size_x(static_cast<unsigned>(std::lround(width / kResolution)))
+    , size_y(static_cast<unsigned>(std::lround(height / kResolution)))
+    , cells(static_cast<size_t>(size_x) * size_y, 0)
+  {
+  }
+
+  /// Mark every cell whose centre is within half a wall thickness of segment a-b [m].
+  void wall(double ax, double ay, double bx, double by)
+  {
+    const double half = 0.5 * kWall;
+    const int x0 = std::max(0, static_cast<int>((std::min(ax, bx) - half) / kResolution) - 1);
+    const int x1 =
+        std::min<int>(size_x - 1, static_cast<int>((std::max(ax, bx) + half) / kResolution) + 1);
+    const int y0 = std::max(0, static_cast<int>((std::min(ay, by) - half) / kResolution) - 1);
+    const int y1 =
+        std::min<int>(size_y - 1, static_cast<int>((std::max(ay, by) + half) / kResolution) + 1);
+    const double dx = bx - ax;
+    const double dy = by - ay;
+    const double len2 = dx * dx + dy * dy;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+      {
+        const double cx = (x + 0.5) * kResolution;
+        const double cy = (y + 0.5) * kResolution;
+        const double s = std::clamp(((cx - ax) * dx + (cy - ay) * dy) / len2, 0.0, 1.0);
+        if (std::hypot(cx - ax - s * dx, cy - ay - s * dy) <= half + 1e-9)
+          cells[static_cast<size_t>(y) * size_x + x] = 1;
+      }
+  }
+
+  /// The benchmark room with its lower-left corner at (ox, oy) [m].
+  void room(double ox, double oy)
+  {
+    const double e = 0.5 * kWall;  // walls run along the inside of the border
+    const double s = kRoomSize;
+    wall(ox + e, oy + e, ox + s - e, oy + e);
+    wall(ox + e, oy + s - e, ox + s - e, oy + s - e);
+    wall(ox + e, oy + e, ox + e, oy + s - e);
+    wall(ox + s - e, oy + e, ox + s - e, oy + s - e);
+    wall(ox + 0.0, oy + 10.0, ox + 8.0, oy + 10.0);   // left room, door from x = 8 to 12
+    wall(ox + 12.0, oy + 4.0, ox + 12.0, oy + 16.0);  // central partition
+    wall(ox + 14.0, oy + 5.0, ox + 20.0, oy + 5.0);   // right room
+    wall(ox + 3.0, oy + 13.5, ox + 7.0, oy + 17.5);   // a diagonal wall
+    for (double y = 13.5; y <= 14.5; y += kResolution)  // a 1 x 1 m pillar
+      wall(ox + 15.5, oy + y, ox + 16.5, oy + y);
+  }
+};
+
+struct Pose
+{
+  double x, y, yaw;
+};
+
+struct Robot
+{
+  double x, y, heading;
+};
+
+/// One benchmark scenario: a map, robots wandering in it, a pool of random free sensor poses.
+struct Scenario
+{
+  GridRaycaster grid;
+  std::vector<Robot> robots;
+  std::vector<Pose> poses;
+  std::mt19937 rng;
+
+  Scenario(const Canvas& canvas, int robot_count, unsigned seed)
+    : grid(canvas.cells, canvas.size_x, canvas.size_y, kResolution, 0.0, 0.0), rng(seed)
+  {
+    for (int i = 0; i < robot_count; ++i)
+    {
+      const Pose p = randomFreePose();
+      robots.push_back({ p.x, p.y, p.yaw });
+    }
+    for (int i = 0; i < 4096; ++i)
+      poses.push_back(randomFreePose());
+  }
+
+  Pose randomFreePose()
+  {
+    std::uniform_real_distribution<double> ux(0.0, grid.sizeX() * kResolution);
+    std::uniform_real_distribution<double> uy(0.0, grid.sizeY() * kResolution);
+    std::uniform_real_distribution<double> uyaw(-M_PI, M_PI);
+    for (;;)
+    {
+      const Pose p{ ux(rng), uy(rng), uyaw(rng) };
+      if (grid.clearanceAt(p.x, p.y) > 2.0 * kRobotRadius)
+        return p;
+    }
+  }
+
+  /// True when (x, y) [m] is inside a robot: a sensor there would read nothing but -Inf.
+  bool insideRobot(double x, double y) const
+  {
+    for (const Robot& r : robots)
+      if (std::hypot(r.x - x, r.y - y) <= kRobotRadius)
+        return true;
+    return false;
+  }
+
+  /// Drive every robot straight on; one that would get close to a wall turns randomly.
+  void moveRobots()
+  {
+    std::uniform_real_distribution<double> uyaw(-M_PI, M_PI);
+    for (Robot& r : robots)
+    {
+      const double nx = r.x + kSpeed * kFrameDt * std::cos(r.heading);
+      const double ny = r.y + kSpeed * kFrameDt * std::sin(r.heading);
+      if (grid.clearanceAt(nx, ny) > kRobotRadius + kResolution)
+      {
+        r.x = nx;
+        r.y = ny;
+      }
+      else
+      {
+        r.heading = uyaw(rng);
+      }
+    }
+  }
+};
+
+struct Result
+{
+  double rays_per_second = 0.0;
+  double cpu_rays_per_second = 0.0;  ///< per second of CPU time: robust on a busy machine
+  double seconds = 0.0;
+  long scans = 0;
+  double returns_fraction = 0.0;  ///< share of finite readings (sanity: the work is real)
+  double rebuild_us = 0.0;        ///< mean ShapeSet rebuild time per frame [us]
+};
+
+/// Per frame: move the robots, rebuild the shape set, cast `scans_per_frame` scans from the
+/// next poses of the pool that are not inside a robot. Times the ray casting work (rebuild +
+/// scans, not the robots' motion nor picking poses) until it adds up to `min_seconds`.
+Result run(Scenario& sc, int scans_per_frame, double min_seconds)
+{
+  using Clock = std::chrono::steady_clock;
+  ShapeSet shapes(4.0);
+  std::vector<float> ranges;
+  ScanSpec spec;
+  spec.beams = kBeams;
+  spec.min_angle = -M_PI;
+  spec.angle_increment = 2.0 * M_PI / kBeams;
+  spec.range_min = 0.05;
+  spec.range_max = kRangeMax;
+
+  Result res;
+  std::vector<const Pose*> frame_poses;
+  long finite = 0;
+  long rays = 0;
+  size_t next_pose = 0;
+  double rebuild_s = 0.0;
+  long frames = 0;
+  double elapsed = 0.0;
+  double cpu_seconds = 0.0;
+  while (elapsed < min_seconds)
+  {
+    sc.moveRobots();
+    frame_poses.clear();
+    while (static_cast<int>(frame_poses.size()) < scans_per_frame)
+    {
+      const Pose& p = sc.poses[next_pose++ % sc.poses.size()];
+      if (!sc.insideRobot(p.x, p.y))
+        frame_poses.push_back(&p);
+    }
+
+    const auto start = Clock::now();
+    const std::clock_t cpu_start = std::clock();
+    shapes.clear();
+    for (size_t i = 0; i < sc.robots.size(); ++i)
+    {
+      Circle c;
+      c.x = sc.robots[i].x;
+      c.y = sc.robots[i].y;
+      c.radius = kRobotRadius;
+      c.owner = static_cast<int>(i);
+      shapes.addCircle(c);
+    }
+    const auto rebuilt = Clock::now();
+    ++frames;
+
+    for (const Pose* p : frame_poses)
+    {
+      spec.x = p->x;
+      spec.y = p->y;
+      spec.yaw = p->yaw;
+      mbot_sim::castScan(sc.grid, shapes, spec, ranges);
+      rays += kBeams;
+      for (float r : ranges)
+        finite += std::isfinite(r) ? 1 : 0;
+    }
+    const auto end = Clock::now();
+    rebuild_s += std::chrono::duration<double>(rebuilt - start).count();
+    elapsed += std::chrono::duration<double>(end - start).count();
+    cpu_seconds += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  }
+  res.seconds = elapsed;
+  res.cpu_rays_per_second = rays / cpu_seconds;
+  res.scans = rays / kBeams;
+  res.rays_per_second = rays / elapsed;
+  res.returns_fraction = static_cast<double>(finite) / rays;
+  res.rebuild_us = 1e6 * rebuild_s / frames;
+  return res;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  double seconds = 2.0;
+  for (int i = 1; i < argc; ++i)
+  {
+    if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
+      seconds = std::max(1.0, std::atof(argv[++i]));
+    else
+    {
+      std::fprintf(stderr, "usage: %s [--seconds S]\n", argv[0]);
+      return 2;
+    }
+  }
+
+  // The room with 10 robots: the headline number.
+  Canvas room(kRoomSize, kRoomSize);
+  room.room(0.0, 0.0);
+  Scenario small(room, 10, 1);
+  run(small, 10, 0.2);  // warm up caches and the CPU clock
+  const Result a = run(small, 10, seconds);
+
+  // The room tiled 3 x 3 (60 x 60 m) with 1000 robots: a scan must only visit nearby buckets.
+  Canvas big(3 * kRoomSize, 3 * kRoomSize);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      big.room(i * kRoomSize, j * kRoomSize);
+  Scenario large(big, 1000, 2);
+  const Result b = run(large, 100, seconds);
+
+  // One JSON line (scripts/bench reads the last line starting with '{').
+  std::printf("{\"rays_per_second\": %.0f, \"beams\": %d, \"range_max\": %.1f, ",
+              a.rays_per_second, kBeams, kRangeMax);
+  std::printf("\"cpu_rays_per_second\": %.0f, \"ns_per_ray\": %.2f, \"scans\": %ld, "
+              "\"seconds\": %.3f, ",
+              a.cpu_rays_per_second, 1e9 / a.rays_per_second, a.scans, a.seconds);
+  std::printf("\"map\": \"room 20x20 m, 0.05 m cells\", \"robots\": 10, "
+              "\"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f, ",
+              a.returns_fraction, a.rebuild_us);
+  std::printf("\"large_map\": {\"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
+              "\"scans\": %ld, \"seconds\": %.3f, \"map\": \"room tiled 3x3, 60x60 m\", "
+              "\"robots\": 1000, \"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f}}\n",
+              b.rays_per_second, b.cpu_rays_per_second, b.scans, b.seconds, b.returns_fraction,
+              b.rebuild_us);
+  return 0;
+}

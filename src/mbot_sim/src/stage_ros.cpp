@@ -1,0 +1,484 @@
+/**
+ * @file stage_ros.cpp
+ * @brief The ROS wrapper of World: parameters, messages, services, sim time. See stage_ros.h.
+ */
+#include "mbot_sim/stage_ros.h"
+
+#include <mbot_msgs/Contact.h>
+#include <ros/callback_queue.h>
+#include <ros/package.h>
+#include <rosgraph_msgs/Clock.h>
+#include <visualization_msgs/MarkerArray.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace mbot_sim
+{
+namespace
+{
+bool fileExists(const std::string& path)
+{
+  struct stat info;
+  return stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
+}
+
+geometry_msgs::Quaternion yawToQuaternion(double yaw)
+{
+  geometry_msgs::Quaternion q;
+  q.z = std::sin(yaw / 2.0);
+  q.w = std::cos(yaw / 2.0);
+  return q;
+}
+
+/// Fill pose and twist of an Odometry message.
+void fillOdometry(nav_msgs::Odometry& msg, double stamp, const Pose2D& pose, const Twist2D& twist)
+{
+  msg.header.stamp.fromSec(stamp);
+  msg.pose.pose.position.x = pose.x;
+  msg.pose.pose.position.y = pose.y;
+  msg.pose.pose.position.z = 0.0;
+  msg.pose.pose.orientation = yawToQuaternion(pose.yaw);
+  msg.twist.twist.linear.x = twist.vx;
+  msg.twist.twist.linear.y = twist.vy;
+  msg.twist.twist.angular.z = twist.wz;
+}
+
+}  // namespace
+
+// =============================================================================================
+// parameters
+
+StageParams readStageParams(const ros::NodeHandle& pnh)
+{
+  StageParams p;
+  if (!pnh.getParam("world", p.world) || p.world.empty())
+    throw StartupError(pnh.resolveName("world") +
+                       ": missing parameter: expected a world name (maps/NAME.world.yaml) or a world file path");
+  pnh.param<std::string>("maps_dir", p.maps_dir, "");
+  if (pnh.hasParam("real_time_factor"))
+  {
+    if (!pnh.getParam("real_time_factor", p.real_time_factor) || !(p.real_time_factor >= 0.0))
+      throw StartupError(pnh.resolveName("real_time_factor") + ": expected a number >= 0 (0 = as fast as possible)");
+    p.has_real_time_factor = true;
+  }
+  if (pnh.hasParam("seed"))
+  {
+    if (!pnh.getParam("seed", p.seed) || p.seed < 0)
+      throw StartupError(pnh.resolveName("seed") + ": expected an integer >= 0");
+    p.has_seed = true;
+  }
+  pnh.param("base_watchdog_timeout", p.watchdog_timeout, 0.2);
+  if (!(p.watchdog_timeout > 0.0))
+    throw StartupError(pnh.resolveName("base_watchdog_timeout") + ": expected a number > 0 [s]");
+  pnh.param("marker_rate", p.marker_rate, 10.0);
+  if (!(p.marker_rate > 0.0)) throw StartupError(pnh.resolveName("marker_rate") + ": expected a number > 0 [Hz]");
+  return p;
+}
+
+std::string resolveWorldPath(const std::string& world, const std::string& maps_dir)
+{
+  const bool is_path = world.find('/') != std::string::npos ||
+                       (world.size() > 5 && world.compare(world.size() - 5, 5, ".yaml") == 0);
+  if (is_path) return world;  // the world reader reports a missing file with its name
+
+  std::vector<std::string> candidates;
+  if (!maps_dir.empty()) candidates.push_back(maps_dir + "/" + world + ".world.yaml");
+  const std::string pkg = ros::package::getPath("mbot_sim");
+  if (!pkg.empty())
+  {
+    candidates.push_back(pkg + "/../../maps/" + world + ".world.yaml");  // source space: <ws>/src/mbot_sim
+    candidates.push_back(pkg + "/maps/" + world + ".world.yaml");        // an install that ships maps
+  }
+  for (const auto& c : candidates)
+    if (fileExists(c)) return c;
+  std::string searched;
+  for (const auto& c : candidates) searched += (searched.empty() ? "" : ", ") + c;
+  throw StartupError("world \"" + world + "\": no world file of that name (searched " + searched + ")");
+}
+
+// =============================================================================================
+// construction
+
+StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(nh), params_(params)
+{
+  const std::string path = resolveWorldPath(params.world, params.maps_dir);
+  description_dir_ = ros::package::getPath("mbot_description");
+  if (description_dir_.empty()) throw StartupError("cannot find the package mbot_description (for the robot models)");
+
+  WorldConfig config;
+  try
+  {
+    config = loadWorldConfig(path);
+    if (params.has_seed) config.seed = static_cast<unsigned>(params.seed);
+    world_ = buildWorld(config, [this](const std::string& name) { return model(name); }, params.watchdog_timeout);
+  }
+  catch (const WorldConfigError& e)
+  {
+    throw StartupError(e.what());
+  }
+  real_time_factor_ = params.has_real_time_factor ? params.real_time_factor : config.real_time_factor;
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  contact_pub_ = nh_.advertise<mbot_msgs::Contact>("contacts", 100);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("stage/markers", 1, true);
+  for (int id : world_->robotIds()) addRobotIo(id);
+  publishRobotList();
+  publishMarkers();
+
+  services_.push_back(nh_.advertiseService("reset", &StageRos::onReset, this));
+  services_.push_back(nh_.advertiseService("reset_positions", &StageRos::onReset, this));
+  services_.push_back(nh_.advertiseService("pause_physics", &StageRos::onPause, this));
+  services_.push_back(nh_.advertiseService("unpause_physics", &StageRos::onUnpause, this));
+  services_.push_back(nh_.advertiseService("spawn_robot", &StageRos::onSpawn, this));
+  services_.push_back(nh_.advertiseService("remove_robot", &StageRos::onRemove, this));
+  services_.push_back(nh_.advertiseService("teleport_robot", &StageRos::onTeleport, this));
+  services_.push_back(nh_.advertiseService("set_fault", &StageRos::onSetFault, this));
+  world_->setListener(this);
+
+  ROS_INFO("stage_node: world %s: %zu robots, %zu obstacles, map walls as %zu boxes, physics step %.3f s, "
+           "real-time factor %g%s, seed %u",
+           path.c_str(), world_->robotCount(), world_->obstacles().size(), world_->wallBoxCount(),
+           world_->physicsStep(), real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "",
+           config.seed);
+}
+
+const mbot_description::RobotModel& StageRos::model(const std::string& name)
+{
+  auto it = models_.find(name);
+  if (it == models_.end())
+    it = models_.emplace(name, mbot_description::loadRobotModel(description_dir_, name)).first;
+  return it->second;
+}
+
+void StageRos::addRobotIo(int id)
+{
+  auto io = std::make_unique<RobotIo>();
+  io->name = world_->robotName(id);
+  io->prefix = io->name + "/";
+  const std::string ns = io->name + "/";
+  // Queues of 100 (2 s at 50 Hz in real time): a subscriber that stalls briefly, or a fast
+  // real-time factor, does not lose messages.
+  io->odom = nh_.advertise<nav_msgs::Odometry>(ns + "odom", 100);
+  io->ground_truth = nh_.advertise<nav_msgs::Odometry>(ns + "base_pose_ground_truth", 100);
+  io->scan = nh_.advertise<sensor_msgs::LaserScan>(ns + "scan", 100);
+  io->joint_states = nh_.advertise<sensor_msgs::JointState>(ns + "joint_states", 100);
+  io->cmd_vel = nh_.subscribe<geometry_msgs::Twist>(
+      ns + "cmd_vel", 1, [this, id](const geometry_msgs::Twist::ConstPtr& msg) { onCmdVel(id, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  io->cmd_pose = nh_.subscribe<geometry_msgs::Pose2D>(
+      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose2D::ConstPtr& msg) { onCmdPose(id, msg); });
+
+  // Message parts that never change, filled once.
+  const mbot_description::RobotModel& m = world_->robotModel(id);
+  io->odom_msg.header.frame_id = io->prefix + "odom";
+  io->odom_msg.child_frame_id = io->prefix + "base_footprint";
+  io->ground_truth_msg.header.frame_id = "map";
+  io->ground_truth_msg.child_frame_id = io->prefix + "base_footprint";
+  io->odom_tf.header.frame_id = io->odom_msg.header.frame_id;
+  io->odom_tf.child_frame_id = io->odom_msg.child_frame_id;
+  io->scan_msg.header.frame_id = io->prefix + "base_laser";
+  io->scan_msg.angle_min = m.laser.min_angle;
+  io->scan_msg.angle_increment = m.laser.angleIncrement();
+  io->scan_msg.angle_max = m.laser.min_angle + m.laser.angleIncrement() * (m.laser.beams - 1);
+  io->scan_msg.time_increment = 0.0;
+  io->scan_msg.scan_time = 1.0 / m.laser.rate;
+  io->scan_msg.range_min = m.laser.range_min;
+  io->scan_msg.range_max = m.laser.range_max;
+  for (const auto& joint : m.wheel_joints) io->joint_msg.name.push_back(io->prefix + joint);
+  if (id >= static_cast<int>(io_.size())) io_.resize(id + 1);
+  io_[id] = std::move(io);
+}
+
+/// `/stage/robots`: [{name, model}, ...]. The robot_state_publishers helper starts one
+/// robot_state_publisher per entry; tools can list the robots from it.
+void StageRos::publishRobotList()
+{
+  XmlRpc::XmlRpcValue list;
+  list.setSize(0);
+  int i = 0;
+  for (int id : world_->robotIds())
+  {
+    XmlRpc::XmlRpcValue entry;
+    entry["name"] = world_->robotName(id);
+    entry["model"] = world_->robotModel(id).name;
+    list[i++] = entry;
+  }
+  nh_.setParam("stage/robots", list);
+}
+
+void StageRos::publishMarkers()
+{
+  visualization_msgs::MarkerArray array;
+  int index = 0;
+  for (const ObstacleState& o : world_->obstacles())
+  {
+    visualization_msgs::Marker m;
+    m.header.frame_id = "map";
+    m.header.stamp.fromSec(world_->time());
+    m.ns = o.moving ? "moving_obstacles" : "obstacles";
+    m.id = index++;
+    m.action = visualization_msgs::Marker::ADD;
+    const bool box = o.shape.type == ShapeConfig::Type::BOX;
+    m.type = box ? visualization_msgs::Marker::CUBE : visualization_msgs::Marker::CYLINDER;
+    m.pose.position.x = o.pose.x;
+    m.pose.position.y = o.pose.y;
+    m.pose.position.z = 0.25;
+    m.pose.orientation = yawToQuaternion(o.pose.yaw);
+    m.scale.x = box ? o.shape.length : 2.0 * o.shape.radius;
+    m.scale.y = box ? o.shape.width : 2.0 * o.shape.radius;
+    m.scale.z = 0.5;
+    m.color.r = o.moving ? 0.9f : 0.55f;
+    m.color.g = o.moving ? 0.45f : 0.4f;
+    m.color.b = o.moving ? 0.1f : 0.3f;
+    m.color.a = 1.0f;
+    m.text = o.name;
+    array.markers.push_back(m);
+  }
+  marker_pub_.publish(array);
+}
+
+// =============================================================================================
+// the loop
+
+void StageRos::publishClock()
+{
+  rosgraph_msgs::Clock clock;
+  clock.clock.fromSec(world_->time());
+  clock_pub_.publish(clock);
+}
+
+void StageRos::run()
+{
+  ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
+  ros::WallTime anchor_wall = ros::WallTime::now();
+  double anchor_sim = world_->time();
+  bool has_movers = false;
+  for (const auto& o : world_->obstacles()) has_movers = has_movers || o.moving;
+
+  while (ros::ok())
+  {
+    queue.callAvailable(ros::WallDuration(0));
+    if (paused_)
+    {
+      queue.callAvailable(ros::WallDuration(0.01));  // wait for unpause, without spinning hot
+      pacing_reset_ = true;
+      continue;
+    }
+    if (pacing_reset_)
+    {
+      anchor_wall = ros::WallTime::now();
+      anchor_sim = world_->time();
+      pacing_reset_ = false;
+    }
+
+    world_->step();  // calls the on*() listeners, which publish
+    if (!tf_batch_.empty())
+    {
+      tf_broadcaster_.sendTransform(tf_batch_);
+      tf_batch_.clear();
+    }
+    publishClock();
+    if (has_movers && world_->time() + 1e-9 >= next_marker_time_)
+    {
+      publishMarkers();
+      next_marker_time_ = world_->time() + 1.0 / params_.marker_rate;
+    }
+
+    if (real_time_factor_ > 0.0)
+    {
+      const ros::WallTime due = anchor_wall + ros::WallDuration((world_->time() - anchor_sim) / real_time_factor_);
+      const ros::WallTime now = ros::WallTime::now();
+      if (due > now)
+        (due - now).sleep();
+      else if ((now - due).toSec() > 0.1)
+        pacing_reset_ = true;  // too slow for this factor: go on from here, no catch-up burst
+    }
+  }
+}
+
+// =============================================================================================
+// sensor samples -> messages
+
+void StageRos::onOdometry(int robot, const OdometrySample& s)
+{
+  RobotIo& io = *io_[robot];
+  fillOdometry(io.odom_msg, s.stamp, s.pose, s.twist);
+  io.odom.publish(io.odom_msg);
+  io.odom_tf.header.stamp = io.odom_msg.header.stamp;
+  io.odom_tf.transform.translation.x = s.pose.x;
+  io.odom_tf.transform.translation.y = s.pose.y;
+  io.odom_tf.transform.translation.z = 0.0;
+  io.odom_tf.transform.rotation = io.odom_msg.pose.pose.orientation;
+  tf_batch_.push_back(io.odom_tf);
+}
+
+void StageRos::onGroundTruth(int robot, const GroundTruthSample& s)
+{
+  RobotIo& io = *io_[robot];
+  fillOdometry(io.ground_truth_msg, s.stamp, s.pose, s.twist);
+  io.ground_truth.publish(io.ground_truth_msg);
+}
+
+void StageRos::onJointState(int robot, const JointStateSample& s)
+{
+  RobotIo& io = *io_[robot];
+  io.joint_msg.header.stamp.fromSec(s.stamp);
+  io.joint_msg.position = s.position;
+  io.joint_msg.velocity = s.velocity;
+  io.joint_states.publish(io.joint_msg);
+}
+
+void StageRos::onScan(int robot, const ScanSample& s)
+{
+  RobotIo& io = *io_[robot];
+  io.scan_msg.header.stamp.fromSec(s.stamp);
+  io.scan_msg.ranges.assign(s.ranges.begin(), s.ranges.end());
+  io.scan.publish(io.scan_msg);
+}
+
+void StageRos::onContact(const ContactEvent& e)
+{
+  mbot_msgs::Contact msg;
+  msg.header.stamp.fromSec(e.stamp);
+  msg.header.frame_id = "map";
+  msg.body_a = e.body_a;
+  msg.body_b = e.body_b;
+  msg.position.x = e.x;
+  msg.position.y = e.y;
+  contact_pub_.publish(msg);
+}
+
+// =============================================================================================
+// commands and services
+
+void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
+{
+  if (!world_->hasRobot(robot)) return;  // removed while the message waited
+  world_->setCommand(robot, Twist2D{msg->linear.x, msg->linear.y, msg->angular.z});
+}
+
+void StageRos::onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg)
+{
+  if (!world_->hasRobot(robot)) return;
+  try
+  {
+    world_->teleport(world_->robotName(robot), Pose2D{msg->x, msg->y, msg->theta});
+  }
+  catch (const std::exception& e)
+  {
+    ROS_WARN("stage_node: cmd_pose: %s", e.what());
+  }
+}
+
+bool StageRos::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+{
+  world_->resetPositions();
+  ROS_INFO("stage_node: reset: robots back at their start poses, odometry at identity");
+  return true;
+}
+
+bool StageRos::onPause(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+{
+  paused_ = true;
+  return true;
+}
+
+bool StageRos::onUnpause(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+{
+  paused_ = false;
+  return true;
+}
+
+bool StageRos::onSpawn(mbot_msgs::SpawnRobot::Request& req, mbot_msgs::SpawnRobot::Response& res)
+{
+  const std::string model_name = req.model.empty() ? "mbot" : req.model;
+  try
+  {
+    const mbot_description::RobotModel& m = model(model_name);
+    const int id = world_->addRobot(req.name, m, Pose2D{req.pose.x, req.pose.y, req.pose.theta});
+    addRobotIo(id);
+    publishRobotList();
+    res.success = true;
+    res.message = "spawned " + req.name + " (" + model_name + ")";
+    ROS_INFO("stage_node: %s", res.message.c_str());
+  }
+  catch (const mbot_description::ModelError& e)
+  {
+    res.success = false;
+    res.message = "unknown or invalid model \"" + model_name + "\": " + e.what();
+  }
+  catch (const std::exception& e)  // SimError: duplicate name, pose in a wall, ...
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;  // the service call itself worked; success says whether the spawn did
+}
+
+bool StageRos::onRemove(mbot_msgs::RemoveRobot::Request& req, mbot_msgs::RemoveRobot::Response& res)
+{
+  const int id = world_->findRobot(req.name);
+  try
+  {
+    world_->removeRobot(req.name);
+    io_[id].reset();  // unadvertises its topics
+    publishRobotList();
+    res.success = true;
+    res.message = "removed " + req.name;
+    ROS_INFO("stage_node: %s", res.message.c_str());
+  }
+  catch (const std::exception& e)  // SimError: unknown robot, bad pose or value
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool StageRos::onTeleport(mbot_msgs::TeleportRobot::Request& req, mbot_msgs::TeleportRobot::Response& res)
+{
+  try
+  {
+    world_->teleport(req.name, Pose2D{req.pose.x, req.pose.y, req.pose.theta});
+    res.success = true;
+    res.message = "teleported " + req.name;
+  }
+  catch (const std::exception& e)  // SimError: unknown robot, bad pose or value
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool StageRos::onSetFault(mbot_msgs::SetFault::Request& req, mbot_msgs::SetFault::Response& res)
+{
+  FaultConfig f;
+  f.laser_dropout = req.laser_dropout;
+  f.sensor_latency = req.sensor_latency;
+  f.sensor_jitter = req.sensor_jitter;
+  f.odom_drift = req.odom_drift;
+  f.drive_frozen = req.drive_frozen;
+  f.silenced = req.silenced;
+  try
+  {
+    world_->setFaults(req.robot, f);
+    res.success = true;
+    res.message = "faults of " + req.robot + " set";
+    ROS_INFO("stage_node: faults of %s: dropout %.2f, latency %.3f s, jitter %.3f s, drift %.3f rad/s%s%s",
+             req.robot.c_str(), f.laser_dropout, f.sensor_latency, f.sensor_jitter, f.odom_drift,
+             f.drive_frozen ? ", drive frozen" : "", f.silenced ? ", silenced" : "");
+  }
+  catch (const std::exception& e)  // SimError: unknown robot, bad pose or value
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+}  // namespace mbot_sim

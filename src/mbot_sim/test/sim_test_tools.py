@@ -1,0 +1,166 @@
+"""Shared helpers of the mbot_sim rostest nodes: message recorders, sim-time driving, the fixture map.
+
+Everything waits in sim time (rospy.sleep, rospy.Rate with /use_sim_time); wall clock is used
+only as a safety timeout while waiting for the simulator to come up.
+"""
+import math
+import os
+import threading
+import time
+
+import rospy
+
+FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
+
+
+def yaw_of(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class Recorder(object):
+    """Subscribes to a topic and keeps every message with the sim time it arrived at."""
+
+    def __init__(self, topic, msg_type):
+        self._lock = threading.Lock()
+        self.messages = []  # (receive sim time [s], message)
+        self.sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=1000)
+
+    def _callback(self, msg):
+        with self._lock:
+            self.messages.append((rospy.get_time(), msg))
+
+    def latest(self):
+        with self._lock:
+            return self.messages[-1][1] if self.messages else None
+
+    def since(self, t):
+        """Messages received at or after sim time t."""
+        with self._lock:
+            return [m for (rt, m) in self.messages if rt >= t]
+
+    def stamped_after(self, t):
+        """Messages whose header stamp is later than sim time t (measured after t)."""
+        with self._lock:
+            return [m for (_, m) in self.messages if m.header.stamp.to_sec() > t]
+
+    def received_since(self, t):
+        with self._lock:
+            return [(rt, m) for (rt, m) in self.messages if rt >= t]
+
+    def first_stamped_after(self, t, sim_timeout=5.0):
+        """The first message whose header stamp is later than sim time t (waits for it)."""
+        deadline = rospy.get_time() + sim_timeout
+        wall_deadline = time.time() + 60.0
+        while not rospy.is_shutdown() and rospy.get_time() < deadline and time.time() < wall_deadline:
+            with self._lock:
+                for (_, m) in self.messages:
+                    if m.header.stamp.to_sec() > t:
+                        return m
+            rospy.sleep(0.01)
+        raise AssertionError("no message on %s stamped after t = %.2f" % (self.sub.name, t))
+
+    def wait_for_first(self, wall_timeout=30.0):
+        end = time.time() + wall_timeout
+        while not rospy.is_shutdown() and time.time() < end:
+            if self.latest() is not None:
+                return self.latest()
+            time.sleep(0.05)
+        raise AssertionError("no message on %s within %.0f s (wall)" % (self.sub.name, wall_timeout))
+
+
+def wait_until(condition, sim_timeout, what):
+    """Wait (sim time) until condition() is true; fail naming `what` after sim_timeout."""
+    deadline = rospy.get_time() + sim_timeout
+    wall_deadline = time.time() + 60.0
+    while not rospy.is_shutdown() and rospy.get_time() < deadline and time.time() < wall_deadline:
+        if condition():
+            return
+        rospy.sleep(0.01)
+    if not condition():
+        raise AssertionError("timed out waiting for " + what)
+
+
+def wait_for_connection(publisher, wall_timeout=10.0):
+    end = time.time() + wall_timeout
+    while publisher.get_num_connections() == 0 and time.time() < end:
+        time.sleep(0.02)
+    if publisher.get_num_connections() == 0:
+        raise AssertionError("nobody subscribes to %s" % publisher.name)
+
+
+def publish_for(publisher, msg, seconds, rate_hz=50.0):
+    """Publish msg at rate_hz for `seconds` of sim time; return the sim time of the last one."""
+    rate = rospy.Rate(rate_hz)
+    start = rospy.get_time()
+    last = start
+    while not rospy.is_shutdown() and rospy.get_time() - start < seconds:
+        publisher.publish(msg)
+        last = rospy.get_time()
+        rate.sleep()
+    return last
+
+
+def drive_until(publisher, cmd, condition, sim_timeout, rate_hz=20.0):
+    """Publish cmd at rate_hz (sim time) until condition() holds or sim_timeout passes; then a stop.
+
+    Robust against this process being starved for a while on a busy machine: the watchdog may
+    stop the robot in between, but driving goes on until the condition holds.
+    """
+    from geometry_msgs.msg import Twist
+    rate = rospy.Rate(rate_hz)
+    deadline = rospy.get_time() + sim_timeout
+    while not rospy.is_shutdown() and not condition() and rospy.get_time() < deadline:
+        publisher.publish(cmd)
+        rate.sleep()
+    publisher.publish(Twist())
+
+
+def load_pgm_map(yaml_name):
+    """The fixture map as (occupied(ix, iy) -> bool, resolution, origin_x, origin_y, width, height).
+
+    Reads the map_server yaml and the binary PGM with the map_server rules (negate 0, p > occupied).
+    """
+    import yaml
+    with open(os.path.join(FIXTURES, yaml_name)) as f:
+        info = yaml.safe_load(f)
+    with open(os.path.join(FIXTURES, info["image"]), "rb") as f:
+        data = f.read()
+    tokens, pos = [], 0
+    while len(tokens) < 4:
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            while data[pos:pos + 1] != b"\n":
+                pos += 1
+            continue
+        start = pos
+        while not data[pos:pos + 1].isspace():
+            pos += 1
+        tokens.append(data[start:pos])
+    assert tokens[0] == b"P5"
+    width, height = int(tokens[1]), int(tokens[2])
+    pixels = data[pos + 1:pos + 1 + width * height]
+    res = float(info["resolution"])
+    ox, oy = float(info["origin"][0]), float(info["origin"][1])
+    thresh = float(info["occupied_thresh"])
+
+    def occupied(ix, iy):
+        if ix < 0 or iy < 0 or ix >= width or iy >= height:
+            return False
+        value = pixels[(height - 1 - iy) * width + ix]  # map row 0 is the image's bottom row
+        return (255 - value) / 255.0 > thresh
+
+    return occupied, res, ox, oy, width, height
+
+
+def map_range(occupied, res, ox, oy, x, y, angle, max_range):
+    """Distance from (x, y) along `angle` to the first occupied cell of the map (fine march)."""
+    step = res / 20.0
+    d = 0.0
+    dx, dy = math.cos(angle), math.sin(angle)
+    while d < max_range:
+        px, py = x + d * dx, y + d * dy
+        if occupied(int(math.floor((px - ox) / res)), int(math.floor((py - oy) / res))):
+            return d
+        d += step
+    return float("inf")

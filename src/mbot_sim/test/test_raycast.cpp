@@ -1,0 +1,821 @@
+/**
+ * @file test_raycast.cpp
+ * @brief Exact-geometry tests of the ray casting core: grid walls, circles, boxes, REP-117
+ *        encoding, beam layout, and randomized comparisons against brute-force references.
+ */
+#include "mbot_sim/raycast.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+namespace
+{
+using mbot_sim::Circle;
+using mbot_sim::GridRaycaster;
+using mbot_sim::OrientedBox;
+using mbot_sim::ScanSpec;
+using mbot_sim::ShapeSet;
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+struct Cell
+{
+  int x, y;
+};
+
+GridRaycaster makeGrid(unsigned w, unsigned h, double res, double ox, double oy,
+                       const std::vector<Cell>& occupied)
+{
+  std::vector<uint8_t> cells(static_cast<size_t>(w) * h, 0);
+  for (const Cell& c : occupied)
+    cells[static_cast<size_t>(c.y) * w + c.x] = 1;
+  return GridRaycaster(cells, w, h, res, ox, oy);
+}
+
+/// Reference: ray (x, y) + t (cos a, sin a) against the axis-aligned square [x0, x1] x [y0, y1]
+/// by the slab method: entry distance (0 when starting inside), or +Inf on a miss.
+double raySquare(double x, double y, double ux, double uy, double x0, double y0, double x1,
+                 double y1)
+{
+  double t_in = 0.0;
+  double t_out = kInf;
+  const double p[2] = { x, y };
+  const double u[2] = { ux, uy };
+  const double lo[2] = { x0, y0 };
+  const double hi[2] = { x1, y1 };
+  for (int a = 0; a < 2; ++a)
+  {
+    if (u[a] == 0.0)
+    {
+      if (p[a] < lo[a] || p[a] > hi[a])
+        return kInf;
+      continue;
+    }
+    double t0 = (lo[a] - p[a]) / u[a];
+    double t1 = (hi[a] - p[a]) / u[a];
+    if (t0 > t1)
+      std::swap(t0, t1);
+    t_in = std::max(t_in, t0);
+    t_out = std::min(t_out, t1);
+  }
+  return t_in <= t_out ? t_in : kInf;
+}
+
+/// Reference: test the ray against every occupied cell of a grid, return the nearest entry.
+double bruteForceGridCast(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res,
+                          double ox, double oy, double x, double y, double theta, double max_range)
+{
+  const double ux = std::cos(theta);
+  const double uy = std::sin(theta);
+  double best = max_range;
+  for (unsigned j = 0; j < h; ++j)
+    for (unsigned i = 0; i < w; ++i)
+      if (cells[static_cast<size_t>(j) * w + i])
+      {
+        const double t = raySquare(x, y, ux, uy, ox + i * res, oy + j * res, ox + (i + 1) * res,
+                                   oy + (j + 1) * res);
+        best = std::min(best, t);
+      }
+  return best;
+}
+
+/// Reference: ray against a convex polygon given by its corners, by intersecting every edge
+/// as a segment (a different method from the slab test in the library). +Inf on a miss.
+double rayPolygon(double x, double y, double ux, double uy, const std::vector<double>& px,
+                  const std::vector<double>& py)
+{
+  double best = kInf;
+  const size_t n = px.size();
+  for (size_t k = 0; k < n; ++k)
+  {
+    const double ax = px[k], ay = py[k];
+    const double ex = px[(k + 1) % n] - ax, ey = py[(k + 1) % n] - ay;
+    // Solve (x, y) + t u = a + s e.
+    const double den = ux * ey - uy * ex;
+    if (std::abs(den) < 1e-15)
+      continue;
+    const double t = ((ax - x) * ey - (ay - y) * ex) / den;
+    const double s = ((ax - x) * uy - (ay - y) * ux) / den;
+    if (t >= 0.0 && s >= 0.0 && s <= 1.0)
+      best = std::min(best, t);
+  }
+  return best;
+}
+
+std::vector<double> boxCornersX(const OrientedBox& b)
+{
+  const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+  const double lx[4] = { b.half_length, -b.half_length, -b.half_length, b.half_length };
+  const double ly[4] = { b.half_width, b.half_width, -b.half_width, -b.half_width };
+  std::vector<double> out;
+  for (int k = 0; k < 4; ++k)
+    out.push_back(b.x + c * lx[k] - s * ly[k]);
+  return out;
+}
+
+std::vector<double> boxCornersY(const OrientedBox& b)
+{
+  const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+  const double lx[4] = { b.half_length, -b.half_length, -b.half_length, b.half_length };
+  const double ly[4] = { b.half_width, b.half_width, -b.half_width, -b.half_width };
+  std::vector<double> out;
+  for (int k = 0; k < 4; ++k)
+    out.push_back(b.y + s * lx[k] + c * ly[k]);
+  return out;
+}
+
+/// Reference: ray against a circle by solving |p + t u - c| = r for the smaller root.
+double rayCircleRef(double x, double y, double ux, double uy, const Circle& c)
+{
+  const double fx = x - c.x, fy = y - c.y;
+  const double b = fx * ux + fy * uy;
+  const double cc = fx * fx + fy * fy - c.radius * c.radius;
+  const double disc = b * b - cc;
+  if (disc < 0.0)
+    return kInf;
+  const double t = -b - std::sqrt(disc);
+  return t >= 0.0 ? t : kInf;
+}
+
+ScanSpec oneBeam(double x, double y, double yaw, double range_max)
+{
+  ScanSpec s;
+  s.x = x;
+  s.y = y;
+  s.yaw = yaw;
+  s.beams = 1;
+  s.range_min = 0.0;
+  s.range_max = range_max;
+  return s;
+}
+
+/// An empty 10 x 10 m grid around the origin, for shape-only tests.
+GridRaycaster emptyGrid()
+{
+  return makeGrid(200, 200, 0.05, -5.0, -5.0, {});
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Grid
+// ---------------------------------------------------------------------------------------------
+
+TEST(GridRaycaster, WallTwoMetresAwayReadsTwoMinusHalfACell)
+{
+  // 0.05 m cells, origin off zero. The sensor sits at the centre of cell (60, 60); walls are
+  // cells whose centres are 2 m = 40 cells away in each direction.
+  const double res = 0.05, ox = -3.2, oy = 1.7;
+  std::vector<Cell> walls;
+  for (int k = 0; k < 121; ++k)
+  {
+    walls.push_back({ 100, k });
+    walls.push_back({ 20, k });
+    walls.push_back({ k, 100 });
+    walls.push_back({ k, 20 });
+  }
+  const GridRaycaster grid = makeGrid(121, 121, res, ox, oy, walls);
+  const double x = ox + 60.5 * res, y = oy + 60.5 * res;
+  const double expected = 2.0 - 0.5 * res;
+  EXPECT_NEAR(grid.cast(x, y, 0.0, 8.0), expected, 1e-6);
+  EXPECT_NEAR(grid.cast(x, y, M_PI / 2, 8.0), expected, 1e-6);
+  EXPECT_NEAR(grid.cast(x, y, M_PI, 8.0), expected, 1e-6);
+  EXPECT_NEAR(grid.cast(x, y, -M_PI / 2, 8.0), expected, 1e-6);
+  // Shorter max range: nothing within it.
+  EXPECT_EQ(grid.cast(x, y, 0.0, 1.5), 1.5);
+  EXPECT_TRUE(grid.occupiedAt(ox + 100.5 * res, y));
+  EXPECT_FALSE(grid.occupiedAt(x, y));
+}
+
+TEST(GridRaycaster, SingleCellAlongDiagonalsHitsTheCorner)
+{
+  // One occupied cell (20, 20); the sensor at cell centres on the four diagonals.
+  const double res = 0.1;
+  const GridRaycaster grid = makeGrid(41, 41, res, 0.0, 0.0, { { 20, 20 } });
+  // From (10.5, 10.5) cells towards +x+y: enters the cell through its corner (20, 20).
+  const double d = 9.5 * std::sqrt(2.0) * res;
+  EXPECT_NEAR(grid.cast(10.5 * res, 10.5 * res, M_PI / 4, 8.0), d, 1e-9);
+  // From (30.5, 30.5) towards -x-y: enters through corner (21, 21).
+  EXPECT_NEAR(grid.cast(30.5 * res, 30.5 * res, -3 * M_PI / 4, 8.0), d, 1e-9);
+  EXPECT_NEAR(grid.cast(30.5 * res, 10.5 * res, 3 * M_PI / 4, 8.0), d, 1e-9);
+  EXPECT_NEAR(grid.cast(10.5 * res, 30.5 * res, -M_PI / 4, 8.0), d, 1e-9);
+}
+
+TEST(GridRaycaster, SingleCellAtOddAnglesMatchesAnalyticSquare)
+{
+  const double res = 0.05;
+  const int cx = 37, cy = 23;
+  const GridRaycaster grid = makeGrid(80, 60, res, 0.0, 0.0, { { cx, cy } });
+  const double x0 = cx * res, y0 = cy * res, x1 = x0 + res, y1 = y0 + res;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> ux(0.0, 80 * res), uy(0.0, 60 * res);
+  std::uniform_real_distribution<double> in_cell(0.0, 1.0);
+  int hits = 0;
+  for (int k = 0; k < 2000; ++k)
+  {
+    const double x = ux(rng), y = uy(rng);
+    // Aim at a random point of the cell, so that most rays hit it at odd angles.
+    const double tx = x0 + in_cell(rng) * res, ty = y0 + in_cell(rng) * res;
+    const double theta = std::atan2(ty - y, tx - x);
+    const double expected = std::min(
+        8.0, raySquare(x, y, std::cos(theta), std::sin(theta), x0, y0, x1, y1));
+    const double got = grid.cast(x, y, theta, 8.0);
+    ASSERT_NEAR(got, expected, 1e-9) << "ray from (" << x << ", " << y << ") at " << theta;
+    hits += expected < 8.0 ? 1 : 0;
+  }
+  EXPECT_EQ(hits, 2000);
+}
+
+TEST(GridRaycaster, OriginOutsideTheGridAndRaysLeavingIt)
+{
+  const double res = 0.05;
+  // A 5 x 5 m grid at the origin with one wall column at x = 4 m (cells 80).
+  std::vector<Cell> walls;
+  for (int k = 0; k < 100; ++k)
+    walls.push_back({ 80, k });
+  const GridRaycaster grid = makeGrid(100, 100, res, 0.0, 0.0, walls);
+  // Outside, looking away: max range.
+  EXPECT_EQ(grid.cast(-1.0, 2.0, M_PI, 8.0), 8.0);
+  // Outside, looking into the grid: outside is free, the ray enters and hits the wall.
+  EXPECT_NEAR(grid.cast(-1.0, 2.0, 0.0, 8.0), 5.0, 1e-9);
+  // Outside, passing beside the grid: max range.
+  EXPECT_EQ(grid.cast(-1.0, 6.0, 0.0, 8.0), 8.0);
+  // Inside, leaving the grid without a hit (through the bottom edge): max range.
+  EXPECT_EQ(grid.cast(1.0, 2.0, -M_PI / 2, 8.0), 8.0);
+  // Inside, a wall beyond max range.
+  EXPECT_EQ(grid.cast(1.0, 2.0, 0.0, 2.5), 2.5);
+  // Starting inside a wall reads 0.
+  EXPECT_EQ(grid.cast(4.02, 2.0, 0.3, 8.0), 0.0);
+  // Outside and the rest of the grid is empty: free.
+  const GridRaycaster empty = makeGrid(10, 10, res, 0.0, 0.0, {});
+  EXPECT_EQ(empty.cast(0.1, 0.1, 0.7, 8.0), 8.0);
+}
+
+TEST(GridRaycaster, ClearanceIsTheSquareToSquareDistance)
+{
+  // clearanceAt must never exceed the smallest distance between the cell's square and any
+  // occupied square (that is what makes the long steps safe), and is stored rounded down to a
+  // quarter cell, so it is at most a quarter cell less.
+  const double res = 0.1;
+  const std::vector<Cell> occ = { { 5, 5 }, { 6, 5 }, { 20, 14 }, { 3, 17 } };
+  const GridRaycaster grid = makeGrid(30, 20, res, 0.0, 0.0, occ);
+  for (int j = 0; j < 20; ++j)
+    for (int i = 0; i < 30; ++i)
+    {
+      double best = kInf;
+      for (const Cell& c : occ)
+      {
+        const double gx = std::max(std::abs(i - c.x) - 1.0, 0.0);
+        const double gy = std::max(std::abs(j - c.y) - 1.0, 0.0);
+        best = std::min(best, std::hypot(gx, gy));
+      }
+      const double got = grid.clearanceAt((i + 0.5) * res, (j + 0.5) * res);
+      ASSERT_LE(got, best * res) << "cell " << i << ", " << j;
+      ASSERT_GT(got, (best - 0.25 - 1e-3) * res) << "cell " << i << ", " << j;
+    }
+}
+
+TEST(GridRaycaster, QuadrantClearanceIgnoresOnlyWallsBehind)
+{
+  // A ray heading into a quadrant (here: +x, +y and -x, -y) can only enter cells at or ahead
+  // of its cell on both axes. clearanceAlong must never exceed the distance to the occupied
+  // cells there (safety), and is the larger of the clearances over the cells ahead on x and
+  // ahead on y (rounded down to a quarter cell).
+  const double res = 0.1;
+  const int w = 40, h = 30;
+  std::mt19937 rng(11);
+  std::bernoulli_distribution sparse(0.03);
+  std::vector<Cell> occ;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i)
+      if (sparse(rng))
+        occ.push_back({ i, j });
+  const GridRaycaster grid = makeGrid(w, h, res, 0.0, 0.0, occ);
+  auto gap = [](int d) { return std::max(std::abs(d) - 1.0, 0.0); };
+  int longer = 0;
+  for (int sign : { 1, -1 })
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i)
+      {
+        bool wall = false;
+        double ahead_both = kInf, ahead_x = kInf, ahead_y = kInf, any = kInf;
+        for (const Cell& c : occ)
+        {
+          wall = wall || (c.x == i && c.y == j);
+          const double d = std::hypot(gap(c.x - i), gap(c.y - j));
+          const bool ax = sign * (c.x - i) >= 0, ay = sign * (c.y - j) >= 0;
+          any = std::min(any, d);
+          if (ax)
+            ahead_x = std::min(ahead_x, d);
+          if (ay)
+            ahead_y = std::min(ahead_y, d);
+          if (ax && ay)
+            ahead_both = std::min(ahead_both, d);
+        }
+        const double got = grid.clearanceAlong((i + 0.5) * res, (j + 0.5) * res, sign, sign) / res;
+        if (wall)
+        {
+          ASSERT_EQ(got, 0.0);
+          continue;
+        }
+        const double expected = std::min(std::max(ahead_x, ahead_y), 63.75);
+        ASSERT_LE(got, ahead_both) << "cell " << i << ", " << j;  // a jump this long is safe
+        ASSERT_LE(got, expected) << "cell " << i << ", " << j;
+        ASSERT_GT(got, expected - 0.25 - 1e-3) << "cell " << i << ", " << j;
+        longer += got > any + 1.0 ? 1 : 0;
+      }
+  EXPECT_GT(longer, 500);  // ignoring the walls behind really makes jumps longer
+}
+
+TEST(GridRaycaster, RandomRaysMatchBruteForce)
+{
+  // 10,000 random rays in a random grid with scattered cells, blocks and a diagonal wall;
+  // origins also outside the grid and inside walls; every range must equal the per-cell
+  // analytic reference within 1e-5 m.
+  const unsigned w = 90, h = 70;
+  const double res = 0.05, ox = -1.3, oy = 0.4;
+  std::mt19937 rng(42);
+  std::vector<uint8_t> cells(w * h, 0);
+  std::bernoulli_distribution sparse(0.02);
+  for (auto& c : cells)
+    c = sparse(rng) ? 1 : 0;
+  for (int k = 10; k < 60; ++k)
+    cells[static_cast<size_t>(k) * w + k] = 1;  // diagonal staircase
+  for (int y = 30; y < 38; ++y)
+    for (int x = 60; x < 75; ++x)
+      cells[static_cast<size_t>(y) * w + x] = 1;  // a block
+  const GridRaycaster grid(cells, w, h, res, ox, oy);
+
+  std::uniform_real_distribution<double> ux(ox - 0.5, ox + w * res + 0.5);
+  std::uniform_real_distribution<double> uy(oy - 0.5, oy + h * res + 0.5);
+  std::uniform_real_distribution<double> ua(-M_PI, M_PI);
+  std::uniform_real_distribution<double> ur(0.1, 6.0);
+  int hits = 0;
+  for (int k = 0; k < 10000; ++k)
+  {
+    const double x = ux(rng), y = uy(rng), theta = ua(rng), max_range = ur(rng);
+    const double expected =
+        bruteForceGridCast(cells, w, h, res, ox, oy, x, y, theta, max_range);
+    const double got = grid.cast(x, y, theta, max_range);
+    ASSERT_NEAR(got, expected, 1e-5) << "ray " << k << " from (" << x << ", " << y << ") at "
+                                     << theta << " max " << max_range;
+    hits += expected < max_range ? 1 : 0;
+  }
+  // The test is only meaningful if many rays hit something (about half do).
+  EXPECT_GT(hits, 4000);
+}
+
+TEST(GridRaycaster, NearlyAxisParallelRaysAtCellBoundariesMatchBruteForce)
+{
+  // Rays starting within 1e-8 cells of a cell boundary and running almost along it, between
+  // two columns (and two rows) of scattered walls: the tracer must never place such a ray in
+  // the neighbouring cell ahead (it would skip walls of the column the ray is really in).
+  // Cell size and offsets are powers of two, so that every start point is exact and the
+  // reference and the tracer see the same geometry (with a tilt of 1e-12 rad, rounding the
+  // start by 1e-15 cells would move the crossing of the boundary by 1e-3 cells).
+  const unsigned w = 40, h = 40;
+  const double res = 0.0625;
+  std::mt19937 rng(5);
+  std::vector<uint8_t> cells(w * h, 0);
+  std::bernoulli_distribution wall(0.15);
+  for (unsigned k = 0; k < 40; ++k)
+  {
+    cells[k * w + 19] = wall(rng);  // columns 19 and 20, rows 19 and 20
+    cells[k * w + 20] = wall(rng);
+    cells[19 * w + k] = wall(rng);
+    cells[20 * w + k] = wall(rng);
+  }
+  const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
+  const double tilts[] = { 0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7, 1e-4, -1e-4 };
+  const double offsets[] = { -std::ldexp(1.0, -27), -std::ldexp(1.0, -40), 0.0,
+                             std::ldexp(1.0, -40), std::ldexp(1.0, -27) };  // [cells]
+  int hits = 0, rays = 0;
+  for (double along : { 2.5, 13.75, 37.5 })  // [cells] where on the boundary the ray starts
+    for (double off : offsets)
+      for (double tilt : tilts)
+        for (double axis : { 0.0, 0.5 * M_PI, M_PI, 1.5 * M_PI })
+        {
+          const bool vertical = std::abs(std::sin(axis)) > 0.5;
+          // Vertical rays start on the boundary x = 20 cells; horizontal ones on y = 20.
+          const double x = (vertical ? 20.0 + off : along) * res;
+          const double y = (vertical ? along : 20.0 + off) * res;
+          if (grid.occupiedAt(x, y))
+            continue;
+          const double theta = axis + tilt;
+          const double expected = bruteForceGridCast(cells, w, h, res, 0.0, 0.0, x, y, theta, 3.0);
+          const double got = grid.cast(x, y, theta, 3.0);
+          ++rays;
+          if (expected < 3.0)
+            ++hits;
+          // A ray starting exactly on a boundary may touch a wall's edge at t = 0, or run along
+          // it: a tie, which the reference calls a hit and the tracer may not.
+          if (off == 0.0)
+            continue;
+          ASSERT_NEAR(got, expected, 1e-5) << "from (" << x / res << ", " << y / res
+                                           << ") cells at " << theta;
+        }
+  EXPECT_GT(rays, 400);
+  EXPECT_GT(hits, 200);
+}
+
+TEST(GridRaycaster, RejectsInconsistentInput)
+{
+  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(10, 0), 4, 4, 0.05, 0.0, 0.0),
+               std::invalid_argument);
+  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(16, 0), 4, 4, 0.0, 0.0, 0.0),
+               std::invalid_argument);
+  EXPECT_THROW(ShapeSet(0.0), std::invalid_argument);
+  const GridRaycaster grid = makeGrid(4, 4, 0.05, 0.0, 0.0, { { 1, 1 } });
+  EXPECT_THROW(grid.cast(0.1, 0.1, std::nan(""), 1.0), std::invalid_argument);
+  EXPECT_EQ(grid.cast(std::nan(""), 0.1, 0.0, 1.0), 1.0);  // no position: no return
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shapes and scans
+// ---------------------------------------------------------------------------------------------
+
+TEST(CastScan, CircleAtThreeMetresReadsTwoAndAHalf)
+{
+  const GridRaycaster grid = emptyGrid();
+  ShapeSet shapes;
+  Circle c;
+  c.x = 3.0;
+  c.radius = 0.5;
+  shapes.addCircle(c);
+  EXPECT_EQ(shapes.size(), 1u);
+  std::vector<float> ranges;
+  castScan(grid, shapes, oneBeam(0.0, 0.0, 0.0, 8.0), ranges);
+  ASSERT_EQ(ranges.size(), 1u);
+  EXPECT_NEAR(ranges[0], 2.5, 1e-6);
+  // Off-centre beam: the analytic chord entry.
+  const double a = 0.1;
+  castScan(grid, shapes, oneBeam(0.0, 0.0, a, 8.0), ranges);
+  EXPECT_NEAR(ranges[0], 3.0 * std::cos(a) - std::sqrt(0.25 - std::pow(3.0 * std::sin(a), 2)),
+              1e-6);
+  // Just past the tangent (asin(0.5 / 3) = 0.1674 rad): no return.
+  castScan(grid, shapes, oneBeam(0.0, 0.0, 0.17, 8.0), ranges);
+  EXPECT_EQ(ranges[0], std::numeric_limits<float>::infinity());
+}
+
+TEST(CastScan, BoxRotated45DegreesReadsTheAnalyticDistance)
+{
+  const GridRaycaster grid = emptyGrid();
+  ShapeSet shapes;
+  OrientedBox b;
+  b.x = 3.0;
+  b.y = 0.0;
+  b.yaw = M_PI / 4;
+  b.half_length = 0.5;
+  b.half_width = 0.3;
+  shapes.addBox(b);
+  std::vector<float> ranges;
+  const std::vector<double> px = boxCornersX(b), py = boxCornersY(b);
+  castScan(grid, shapes, oneBeam(0.0, 0.0, 0.0, 8.0), ranges);
+  // By hand, straight at the centre: a point (x, 0) is at x' = (x - 3) cos45, y' = -(x - 3)
+  // sin45 in the box frame, inside when |x'| <= 0.5 and |y'| <= 0.3, i.e. |x - 3| <= 0.3 sqrt2.
+  EXPECT_NEAR(ranges[0], 3.0 - 0.3 * std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(ranges[0], rayPolygon(0, 0, 1, 0, px, py), 1e-6);
+  // Many beams at odd angles from another point: each equals the polygon reference.
+  ScanSpec s;
+  s.x = 0.4;
+  s.y = -1.1;
+  s.beams = 720;
+  s.min_angle = -M_PI;
+  s.angle_increment = 2 * M_PI / 720;
+  s.range_max = 8.0;
+  castScan(grid, shapes, s, ranges);
+  int hits = 0;
+  for (int i = 0; i < s.beams; ++i)
+  {
+    const double a = s.yaw + s.min_angle + i * s.angle_increment;
+    const double expected = rayPolygon(s.x, s.y, std::cos(a), std::sin(a), px, py);
+    if (expected < 8.0)
+    {
+      ++hits;
+      EXPECT_NEAR(ranges[i], expected, 1e-5) << "beam " << i;
+    }
+    else
+    {
+      EXPECT_EQ(ranges[i], std::numeric_limits<float>::infinity()) << "beam " << i;
+    }
+  }
+  EXPECT_GT(hits, 10);
+}
+
+TEST(CastScan, OwnBodyIsNotSeen)
+{
+  const GridRaycaster grid = emptyGrid();
+  ShapeSet shapes;
+  Circle self;
+  self.radius = 0.15;
+  self.owner = 3;
+  shapes.addCircle(self);
+  Circle other;
+  other.x = -2.0;
+  other.radius = 0.15;
+  other.owner = 4;
+  shapes.addCircle(other);
+  ScanSpec s;
+  s.beams = 4;
+  s.angle_increment = M_PI / 2;  // beams along +x, +y, -x, -y
+  s.range_min = 0.05;
+  s.range_max = 8.0;
+  s.ignore_owner = 3;
+  std::vector<float> ranges;
+  castScan(grid, shapes, s, ranges);
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(ranges[0], inf);
+  EXPECT_EQ(ranges[1], inf);
+  EXPECT_NEAR(ranges[2], 1.85, 1e-6);  // the other robot is seen
+  EXPECT_EQ(ranges[3], inf);
+  // Without ignoring its owner, the sensor sits inside the circle: every beam reads 0, which
+  // is closer than range_min.
+  s.ignore_owner = -1;
+  castScan(grid, shapes, s, ranges);
+  for (float r : ranges)
+    EXPECT_EQ(r, -inf);
+}
+
+TEST(CastScan, Rep117InfinitiesAndWalls)
+{
+  // A wall column 3 m in front of the sensor.
+  std::vector<Cell> walls;
+  for (int k = 0; k < 200; ++k)
+    walls.push_back({ 160, k });  // x in [3.0, 3.05]
+  const GridRaycaster grid = makeGrid(200, 200, 0.05, -5.0, -5.0, walls);
+  ShapeSet shapes;
+  Circle near;
+  near.x = -0.2;
+  near.radius = 0.05;  // 0.15 m away behind the sensor
+  shapes.addCircle(near);
+  ScanSpec s;
+  s.beams = 2;
+  s.angle_increment = M_PI;  // +x and -x
+  s.range_min = 0.2;
+  s.range_max = 8.0;
+  std::vector<float> ranges;
+  castScan(grid, shapes, s, ranges);
+  EXPECT_NEAR(ranges[0], 3.0, 1e-6);
+  EXPECT_EQ(ranges[1], -std::numeric_limits<float>::infinity());  // closer than range_min
+  s.range_max = 2.5;
+  castScan(grid, shapes, s, ranges);
+  EXPECT_EQ(ranges[0], std::numeric_limits<float>::infinity());  // wall beyond range_max
+  // A circle in front of the wall wins; a circle behind it is hidden.
+  Circle front, behind;
+  front.x = 2.0;
+  front.radius = 0.25;
+  behind.x = 3.6;
+  behind.y = 1.0;
+  behind.radius = 0.5;
+  shapes.addCircle(front);
+  shapes.addCircle(behind);
+  s.range_max = 8.0;
+  s.beams = 1;
+  castScan(grid, shapes, s, ranges);
+  EXPECT_NEAR(ranges[0], 1.75, 1e-6);
+  s.yaw = std::atan2(1.0, 3.6);  // towards the hidden circle's centre
+  castScan(grid, shapes, s, ranges);
+  EXPECT_NEAR(ranges[0], 3.0 / std::cos(s.yaw), 1e-5);  // the wall
+  // Sensor outside the grid, rays leaving the grid: +Inf.
+  ScanSpec out = oneBeam(-7.0, 0.0, M_PI, 8.0);
+  castScan(grid, ShapeSet(), out, ranges);
+  EXPECT_EQ(ranges[0], std::numeric_limits<float>::infinity());
+}
+
+TEST(CastScan, BeamLayoutFollowsYawMinAngleAndIncrement)
+{
+  const GridRaycaster grid = emptyGrid();
+  // A tiny circle exactly on beam 123's direction.
+  ScanSpec s;
+  s.x = 0.3;
+  s.y = -0.2;
+  s.yaw = 1.0;
+  s.min_angle = -2.0;
+  s.angle_increment = 0.01;
+  s.beams = 400;
+  s.range_max = 8.0;
+  const double a = s.yaw + s.min_angle + 123 * s.angle_increment;
+  ShapeSet shapes;
+  Circle c;
+  c.x = s.x + 3.0 * std::cos(a);
+  c.y = s.y + 3.0 * std::sin(a);
+  c.radius = 0.001;
+  shapes.addCircle(c);
+  std::vector<float> ranges;
+  castScan(grid, shapes, s, ranges);
+  ASSERT_EQ(ranges.size(), 400u);
+  for (int i = 0; i < s.beams; ++i)
+  {
+    if (i == 123)
+      EXPECT_NEAR(ranges[i], 2.999, 1e-6);
+    else
+      EXPECT_EQ(ranges[i], std::numeric_limits<float>::infinity()) << "beam " << i;
+  }
+  // The same with a negative increment: the circle sits on beam 77 now.
+  s.angle_increment = -0.01;
+  s.min_angle = 0.5;
+  const double b = s.yaw + s.min_angle + 77 * s.angle_increment;
+  shapes.clear();
+  EXPECT_EQ(shapes.size(), 0u);
+  c.x = s.x + 3.0 * std::cos(b);
+  c.y = s.y + 3.0 * std::sin(b);
+  shapes.addCircle(c);
+  castScan(grid, shapes, s, ranges);
+  for (int i = 0; i < s.beams; ++i)
+  {
+    if (i == 77)
+      EXPECT_NEAR(ranges[i], 2.999, 1e-6);
+    else
+      EXPECT_EQ(ranges[i], std::numeric_limits<float>::infinity()) << "beam " << i;
+  }
+}
+
+TEST(CastScan, ManyLaserLayoutsInTurnEachReadRight)
+{
+  // Lasers of different models take turns (more layouts than castScan keeps cached): each
+  // scan must use its own beam layout.
+  const GridRaycaster grid = emptyGrid();
+  ShapeSet shapes;
+  Circle c;
+  c.x = 2.0;
+  c.radius = 0.05;
+  shapes.addCircle(c);
+  std::vector<float> ranges;
+  for (int round = 0; round < 2; ++round)
+    for (int layout = 0; layout < 12; ++layout)
+    {
+      ScanSpec s;
+      s.beams = 100 + layout;
+      s.angle_increment = 0.001 * (layout + 1);
+      s.min_angle = -40 * s.angle_increment;  // beam 40 points along +x, at the circle
+      s.range_max = 8.0;
+      castScan(grid, shapes, s, ranges);
+      ASSERT_EQ(ranges.size(), static_cast<size_t>(s.beams));
+      EXPECT_NEAR(ranges[40], 1.95, 1e-6) << "layout " << layout;
+      EXPECT_EQ(ranges[40 + 26], std::numeric_limits<float>::infinity()) << "layout " << layout;
+    }
+}
+
+TEST(CastScan, ShapeAcrossTheScanSeamIsSeenByFirstAndLastBeams)
+{
+  // A full turn of 360 beams starting at -pi: a circle straight behind the sensor covers the
+  // last beams and the first ones.
+  const GridRaycaster grid = emptyGrid();
+  ShapeSet shapes;
+  Circle c;
+  c.x = -2.0;
+  c.radius = 0.1;
+  shapes.addCircle(c);
+  ScanSpec s;
+  s.beams = 360;
+  s.min_angle = -M_PI + 0.5 * M_PI / 180;  // beams at -179.5, -178.5, ..., 179.5 degrees
+  s.angle_increment = M_PI / 180;
+  s.range_max = 8.0;
+  std::vector<float> ranges;
+  castScan(grid, shapes, s, ranges);
+  // asin(0.1 / 2) = 2.87 degrees: beams within +-2.87 degrees of 180 are hit.
+  for (int i : { 0, 1, 2, 357, 358, 359 })
+  {
+    const double a = s.min_angle + i * s.angle_increment;
+    EXPECT_NEAR(ranges[i], rayCircleRef(0, 0, std::cos(a), std::sin(a), c), 1e-6) << i;
+    EXPECT_LT(ranges[i], 2.0f);
+  }
+  EXPECT_EQ(ranges[3], std::numeric_limits<float>::infinity());
+  EXPECT_EQ(ranges[356], std::numeric_limits<float>::infinity());
+}
+
+TEST(CastScan, RandomScansMatchBruteForce)
+{
+  // Random grid, many random circles and boxes (some large and spanning buckets), small
+  // buckets so that the bucket query matters; every beam of every scan must equal the
+  // brute-force minimum over the grid reference and every shape's reference.
+  const unsigned w = 160, h = 120;
+  const double res = 0.05, ox = -4.0, oy = -3.0;
+  std::mt19937 rng(3);
+  std::vector<uint8_t> cells(w * h, 0);
+  std::bernoulli_distribution sparse(0.004);
+  for (auto& c : cells)
+    c = sparse(rng) ? 1 : 0;
+  for (unsigned x = 0; x < w; ++x)
+    cells[x] = cells[(h - 1) * w + x] = 1;
+  const GridRaycaster grid(cells, w, h, res, ox, oy);
+
+  std::uniform_real_distribution<double> ux(-5.0, 5.0), uy(-4.0, 4.0), ua(-M_PI, M_PI);
+  std::uniform_real_distribution<double> usize(0.05, 0.6);
+  std::vector<Circle> circles;
+  std::vector<OrientedBox> boxes;
+  ShapeSet shapes(1.0);
+  for (int k = 0; k < 60; ++k)
+  {
+    Circle c;
+    c.x = ux(rng);
+    c.y = uy(rng);
+    c.radius = usize(rng);
+    c.owner = k % 5;
+    circles.push_back(c);
+    shapes.addCircle(c);
+  }
+  for (int k = 0; k < 30; ++k)
+  {
+    OrientedBox b;
+    b.x = ux(rng);
+    b.y = uy(rng);
+    b.yaw = ua(rng);
+    b.half_length = usize(rng) * (k == 0 ? 4.0 : 1.0);  // one long box spans buckets
+    b.half_width = usize(rng);
+    b.owner = 10 + k % 3;
+    boxes.push_back(b);
+    shapes.addBox(b);
+  }
+  ASSERT_EQ(shapes.size(), 90u);
+
+  int scans = 0, shape_hits = 0;
+  std::vector<float> ranges;
+  for (int trial = 0; trial < 200 && scans < 40; ++trial)
+  {
+    ScanSpec s;
+    s.x = ux(rng);
+    s.y = uy(rng);
+    s.yaw = ua(rng);
+    s.min_angle = -2.0;
+    s.angle_increment = 4.0 / 179;
+    s.beams = 180;
+    s.range_min = 0.02;
+    s.range_max = 6.0;
+    s.ignore_owner = trial % 7 == 0 ? -1 : trial % 5;
+    // Sensors inside a seen shape read all -Inf; checked elsewhere, skip those here.
+    bool inside = false;
+    for (const Circle& c : circles)
+      if (c.owner != s.ignore_owner && std::hypot(c.x - s.x, c.y - s.y) <= c.radius)
+        inside = true;
+    for (const OrientedBox& b : boxes)
+    {
+      const double lx = std::cos(b.yaw) * (s.x - b.x) + std::sin(b.yaw) * (s.y - b.y);
+      const double ly = -std::sin(b.yaw) * (s.x - b.x) + std::cos(b.yaw) * (s.y - b.y);
+      if (std::abs(lx) <= b.half_length && std::abs(ly) <= b.half_width)
+        inside = true;
+    }
+    if (inside || grid.occupiedAt(s.x, s.y))
+      continue;
+    ++scans;
+    castScan(grid, shapes, s, ranges);
+    for (int i = 0; i < s.beams; ++i)
+    {
+      const double a = s.yaw + s.min_angle + i * s.angle_increment;
+      const double cx = std::cos(a), cy = std::sin(a);
+      double expected = bruteForceGridCast(cells, w, h, res, ox, oy, s.x, s.y, a, s.range_max);
+      double shape = kInf;
+      for (const Circle& c : circles)
+        if (c.owner != s.ignore_owner || s.ignore_owner < 0)
+          shape = std::min(shape, rayCircleRef(s.x, s.y, cx, cy, c));
+      for (const OrientedBox& b : boxes)
+        if (b.owner != s.ignore_owner || s.ignore_owner < 0)
+          shape = std::min(shape, rayPolygon(s.x, s.y, cx, cy, boxCornersX(b), boxCornersY(b)));
+      if (shape < expected)
+      {
+        expected = shape;
+        ++shape_hits;
+      }
+      if (expected >= s.range_max)
+        ASSERT_EQ(ranges[i], std::numeric_limits<float>::infinity())
+            << "scan " << scans << " beam " << i;
+      else if (expected < s.range_min)
+        ASSERT_EQ(ranges[i], -std::numeric_limits<float>::infinity())
+            << "scan " << scans << " beam " << i;
+      else
+        ASSERT_NEAR(ranges[i], expected, 1e-5) << "scan " << scans << " beam " << i;
+    }
+  }
+  EXPECT_EQ(scans, 40);
+  EXPECT_GT(shape_hits, 500);  // shapes really were hit, in front of walls
+}
+
+TEST(CastScan, RejectsBadSpec)
+{
+  const GridRaycaster grid = emptyGrid();
+  std::vector<float> ranges;
+  ScanSpec s = oneBeam(0, 0, 0, 0.0);
+  EXPECT_THROW(castScan(grid, ShapeSet(), s, ranges), std::invalid_argument);
+  s = oneBeam(0, 0, 0, 8.0);
+  s.beams = -1;
+  EXPECT_THROW(castScan(grid, ShapeSet(), s, ranges), std::invalid_argument);
+  s.beams = 0;
+  castScan(grid, ShapeSet(), s, ranges);
+  EXPECT_TRUE(ranges.empty());
+  s.beams = 10;
+  s.yaw = std::nan("");
+  EXPECT_THROW(castScan(grid, ShapeSet(), s, ranges), std::invalid_argument);
+  ShapeSet shapes;
+  Circle c;
+  c.radius = -0.1;
+  EXPECT_THROW(shapes.addCircle(c), std::invalid_argument);
+  OrientedBox b;
+  b.x = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(shapes.addBox(b), std::invalid_argument);
+  EXPECT_EQ(shapes.size(), 0u);
+}

@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""rostest (sim_basics.test): three robots in the room fixture (fixtures/three_robots.world.yaml).
+
+robot_0 is stopped by the watchdog, robot_1 stands and looks at the walls, robot_2 drives into
+the wall block at x = 7.0. All waiting and measuring in sim time. (The 1 m drive, which needs
+exact command timing, is test_sim_drive.py at real-time factor 1.)
+"""
+import math
+import sys
+import unittest
+
+import rospy
+import rostest
+import tf2_ros
+from geometry_msgs.msg import Twist
+from mbot_msgs.msg import Contact
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+
+sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+from sim_test_tools import (Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
+                            publish_for, wait_for_connection, yaw_of)
+
+RADIUS = 0.15  # [m] mbot's footprint radius (urdf/mbot.urdf)
+
+
+def twist(vx=0.0, wz=0.0):
+    msg = Twist()
+    msg.linear.x = vx
+    msg.angular.z = wz
+    return msg
+
+
+class SimBasics(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_sim_basics")
+        cls.truth = {n: Recorder("/%s/base_pose_ground_truth" % n, Odometry) for n in ("robot_0", "robot_1", "robot_2")}
+        cls.scan1 = Recorder("/robot_1/scan", LaserScan)
+        cls.contacts = Recorder("/contacts", Contact)
+        cls.cmd = {n: rospy.Publisher("/%s/cmd_vel" % n, Twist, queue_size=10) for n in ("robot_0", "robot_2")}
+        for rec in list(cls.truth.values()) + [cls.scan1]:
+            rec.wait_for_first()
+        for pub in cls.cmd.values():
+            wait_for_connection(pub)
+        cls.tf_buffer = tf2_ros.Buffer()
+        cls.tf_listener = tf2_ros.TransformListener(cls.tf_buffer)
+
+    def test_1_every_robot_publishes_at_its_rates_in_sim_time(self):
+        names = ("robot_0", "robot_1", "robot_2")
+        odom = {n: Recorder("/%s/odom" % n, Odometry) for n in names}
+        scans = {n: Recorder("/%s/scan" % n, LaserScan) for n in names}
+        for rec in list(odom.values()) + list(scans.values()):
+            rec.wait_for_first()  # connected: from now on every message arrives
+        t0 = rospy.get_time() + 0.1
+        t1 = t0 + 4.0  # count what was measured in [t0, t1): 4 s of sim time
+        for rec in list(odom.values()) + list(scans.values()) + list(self.truth.values()):
+            rec.first_stamped_after(t1, sim_timeout=10.0)  # all of the window has arrived
+        for n in names:
+            for rec, hz in ((odom[n], 50.0), (scans[n], 10.0), (self.truth[n], 50.0)):
+                stamps = sorted(m.header.stamp.to_sec() for m in rec.stamped_after(t0 - 1e-6) if m.header.stamp.to_sec() < t1)
+                self.assertAlmostEqual(len(stamps), 4.0 * hz, delta=1, msg="%s: %d messages in 4 s" % (rec.sub.name, len(stamps)))
+                gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+                self.assertAlmostEqual(max(gaps), 1.0 / hz, delta=1e-6, msg=rec.sub.name)
+                self.assertAlmostEqual(min(gaps), 1.0 / hz, delta=1e-6, msg=rec.sub.name)
+        for rec in list(odom.values()) + list(scans.values()):
+            rec.sub.unregister()
+
+    def test_2_watchdog_stops_the_robot(self):
+        last = publish_for(self.cmd["robot_0"], twist(0.3), 1.0)
+        self.truth["robot_0"].first_stamped_after(last + 2.0, sim_timeout=10.0)
+        speeds = [(m.header.stamp.to_sec(), m.twist.twist.linear.x) for m in self.truth["robot_0"].stamped_after(last - 0.5)]
+        self.assertGreater(len(speeds), 100)
+        stopped_at = next((t for (t, v) in speeds if t > last and abs(v) < 1e-6), None)
+        self.assertIsNotNone(stopped_at, "the robot never stopped")
+        braking_from = max(t for (t, v) in speeds if t < stopped_at and v > 0.3 - 1e-6)
+        # braking from 0.3 m/s at 1 m/s^2 takes 0.3 s
+        self.assertAlmostEqual(stopped_at - braking_from, 0.3, delta=0.045)  # 50 Hz samples
+        # The last command reached the simulator at sim time >= `last` (the test's clock may lag
+        # the simulator's): the robot drives on for the 0.2 s watchdog timeout, then brakes.
+        self.assertGreater(stopped_at - last, 0.49)
+        self.assertLess(stopped_at - last, 1.0)
+        for (t, v) in speeds:
+            if t > stopped_at:
+                self.assertLess(abs(v), 1e-6, "moved again at t = %.2f" % t)
+
+    def test_3_drive_into_wall_stops_at_the_wall_with_one_contact(self):
+        t0 = rospy.get_time()
+        wall_x = 7.0
+        at_wall = lambda: self.truth["robot_2"].latest().pose.pose.position.x > wall_x - RADIUS - 0.03  # noqa: E731
+        drive_until(self.cmd["robot_2"], twist(0.5), at_wall, 20.0)  # 0.85 m to the wall
+        publish_for(self.cmd["robot_2"], twist(0.5), 1.0)  # and push against it for 1 s
+        self.cmd["robot_2"].publish(twist(0.0))
+        rospy.sleep(0.5)
+        xs = [m.pose.pose.position.x for m in self.truth["robot_2"].since(t0)]
+        self.assertGreater(len(xs), 100)
+        self.assertLessEqual(max(xs) + RADIUS, wall_x + 0.002, "the footprint entered the wall")
+        self.assertAlmostEqual(xs[-1], wall_x - RADIUS, delta=0.02)
+        mine = [c for c in self.contacts.since(t0) if {c.body_a, c.body_b} == {"robot_2", "map"}]
+        self.assertEqual(len(mine), 1, "contacts: %s" % [(c.body_a, c.body_b, c.header.stamp.to_sec()) for c in mine])
+        self.assertAlmostEqual(mine[0].position.x, wall_x, delta=0.02)
+        self.assertEqual(mine[0].header.frame_id, "map")
+        self.assertGreater(mine[0].header.stamp.to_sec(), t0)
+
+    def test_4_laser_sees_the_wall_where_the_map_has_it(self):
+        scan = self.scan1.latest()
+        self.assertEqual(scan.header.frame_id, "robot_1/base_laser")
+        self.assertEqual(len(scan.ranges), 360)
+        self.assertAlmostEqual(scan.angle_increment, 2 * math.pi / 360, places=6)
+        self.assertAlmostEqual(scan.range_min, 0.12, places=6)
+        self.assertAlmostEqual(scan.range_max, 8.0, places=6)
+        # where the laser is: ground truth of the base + the URDF mount from tf
+        mount = self.tf_buffer.lookup_transform("robot_1/base_footprint", "robot_1/base_laser", rospy.Time(0),
+                                                rospy.Duration(150.0)).transform.translation
+        base = self.truth["robot_1"].latest().pose.pose
+        yaw = yaw_of(base.orientation)
+        lx = base.position.x + math.cos(yaw) * mount.x - math.sin(yaw) * mount.y
+        ly = base.position.y + math.sin(yaw) * mount.x + math.cos(yaw) * mount.y
+        occupied, res, ox, oy, _, _ = load_pgm_map("room.yaml")
+        checked = 0
+        for index in (0, 90, 270):  # west (-pi), south (-pi/2), north (+pi/2)
+            angle = yaw + scan.angle_min + index * scan.angle_increment
+            expected = map_range(occupied, res, ox, oy, lx, ly, angle, scan.range_max)
+            self.assertTrue(math.isfinite(expected))
+            self.assertAlmostEqual(scan.ranges[index], expected, delta=res,
+                                   msg="beam %d: %.3f m, the map says %.3f m" % (index, scan.ranges[index], expected))
+            checked += 1
+        self.assertEqual(checked, 3)
+
+    def test_5_tf_from_odom_to_laser_resolves(self):
+        # (150 s of sim time = 30 s of wall time at 5x: robot_state_publisher may start slowly)
+        t = self.tf_buffer.lookup_transform("robot_1/odom", "robot_1/base_laser", rospy.Time(0), rospy.Duration(150.0))
+        # robot_1 never moved: odom = base_footprint, so this is the laser mount (0.05, 0, 0.16)
+        self.assertAlmostEqual(t.transform.translation.x, 0.05, delta=1e-3)
+        self.assertAlmostEqual(t.transform.translation.y, 0.0, delta=1e-3)
+        self.assertAlmostEqual(t.transform.translation.z, 0.16, delta=1e-3)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_sim", "sim_basics", SimBasics, sys.argv)

@@ -1,0 +1,660 @@
+/**
+ * @file test_world.cpp
+ * @brief The simulation core without ROS: kinematics against analytic poses, limits, the
+ *        watchdog, contacts, lasers, sensor rates, moving obstacles, determinism, faults and
+ *        the run-time requests.
+ */
+#include "mbot_sim/world.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+using mbot_description::DriveType;
+using mbot_description::RobotModel;
+using namespace mbot_sim;
+
+namespace
+{
+const std::string kFixtures = MBOT_SIM_FIXTURES;
+constexpr double kPi = 3.14159265358979323846;
+
+/// mbot's numbers (urdf/mbot.urdf, config/mbot.yaml): round, r = 0.15 m.
+RobotModel diffModel()
+{
+  RobotModel m;
+  m.name = "mbot";
+  m.drive = DriveType::DIFF;
+  m.footprint_radius = 0.15;
+  for (int i = 0; i < 16; ++i)
+    m.footprint.push_back({0.15 * std::cos(2 * kPi * i / 16), 0.15 * std::sin(2 * kPi * i / 16)});
+  m.mass = 2.4;
+  m.wheel_radius = 0.04;
+  m.wheel_separation = 0.22;
+  m.wheel_joints = {"left_wheel_joint", "right_wheel_joint"};
+  m.laser.mount_x = 0.05;
+  m.laser.mount_z = 0.16;
+  m.limits = mbot_description::Limits{0.5, -0.2, 0.0, 2.0, 1.0, 0.0, 3.0};
+  return m;
+}
+
+/// mbot_omni-like: a 0.3 x 0.24 m box body, mecanum wheels.
+RobotModel omniModel()
+{
+  RobotModel m = diffModel();
+  m.name = "mbot_omni";
+  m.drive = DriveType::OMNI;
+  m.footprint = {{0.15, -0.12}, {0.15, 0.12}, {-0.15, 0.12}, {-0.15, -0.12}};
+  m.footprint_radius = std::hypot(0.15, 0.12);
+  m.wheel_base = 0.2;
+  m.wheel_joints = {"fl", "fr", "rl", "rr"};
+  m.limits = mbot_description::Limits{0.4, -0.4, 0.4, 1.5, 1.0, 1.0, 2.5};
+  return m;
+}
+
+/// Very large acceleration limits: the commanded twist holds from the first step, so the
+/// analytic pose of a constant twist applies.
+RobotModel stiff(RobotModel m)
+{
+  m.limits.acc_lim_x = m.limits.acc_lim_y = m.limits.acc_lim_theta = 1e6;
+  return m;
+}
+
+/// A free 40 m x 40 m map (no walls), origin at (-20, -20).
+OccupancyMap openMap()
+{
+  OccupancyMap map;
+  map.width = map.height = 400;
+  map.resolution = 0.1;
+  map.origin_x = map.origin_y = -20.0;
+  map.data.assign(400 * 400, 0);
+  return map;
+}
+
+OccupancyMap roomMap() { return loadMap(kFixtures + "/room.yaml"); }
+
+/// Keeps every sample and contact.
+struct Recorder : SensorListener
+{
+  std::map<int, std::vector<OdometrySample>> odom;
+  std::map<int, std::vector<GroundTruthSample>> truth;
+  std::map<int, std::vector<ScanSample>> scans;
+  std::map<int, std::vector<JointStateSample>> joints;
+  std::vector<ContactEvent> contacts;
+  std::vector<double> odom_release_times;  ///< sim time at which each odom sample arrived
+  const World* world = nullptr;
+
+  void onOdometry(int r, const OdometrySample& s) override
+  {
+    odom[r].push_back(s);
+    if (world) odom_release_times.push_back(world->time());
+  }
+  void onGroundTruth(int r, const GroundTruthSample& s) override { truth[r].push_back(s); }
+  void onScan(int r, const ScanSample& s) override { scans[r].push_back(s); }
+  void onJointState(int r, const JointStateSample& s) override { joints[r].push_back(s); }
+  void onContact(const ContactEvent& e) override { contacts.push_back(e); }
+
+  int contactsBetween(const std::string& a, const std::string& b) const
+  {
+    int n = 0;
+    for (const auto& c : contacts) n += (c.body_a == a && c.body_b == b) || (c.body_a == b && c.body_b == a);
+    return n;
+  }
+};
+
+/// Drive `robot` with `cmd` for `seconds`, repeating the command at 10 Hz (as a controller does).
+void drive(World& world, int robot, const Twist2D& cmd, double seconds)
+{
+  const int steps = static_cast<int>(std::lround(seconds / world.physicsStep()));
+  for (int i = 0; i < steps; ++i)
+  {
+    if (i % 10 == 0) world.setCommand(robot, cmd);
+    world.step();
+  }
+}
+
+void run(World& world, double seconds)
+{
+  const int steps = static_cast<int>(std::lround(seconds / world.physicsStep()));
+  for (int i = 0; i < steps; ++i) world.step();
+}
+
+/// Index of the beam pointing along `angle` [rad] in the laser frame.
+size_t beamAt(const RobotModel& m, double angle)
+{
+  const double inc = m.laser.angleIncrement();
+  return static_cast<size_t>(std::lround(std::remainder(angle - m.laser.min_angle, 2 * kPi) / inc + m.laser.beams) %
+                             m.laser.beams);
+}
+}  // namespace
+
+// ---- kinematics -------------------------------------------------------------------------------
+
+TEST(Kinematics, DiffDriveArcMatchesTheAnalyticPose)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", stiff(diffModel()), Pose2D{0.0, 0.0, 0.0});
+  const double v = 0.4, w = 0.5, T = 4.0;
+  drive(world, id, Twist2D{v, 0.0, w}, T);
+  const Pose2D p = world.groundTruth(id);
+  const double R = v / w;
+  EXPECT_NEAR(p.x, R * std::sin(w * T), 0.005);
+  EXPECT_NEAR(p.y, R * (1.0 - std::cos(w * T)), 0.005);
+  EXPECT_NEAR(p.yaw, w * T, 0.005);
+  // Without noise the odometry is the ground truth (both start at the same pose here).
+  const Pose2D o = world.odometry(id);
+  EXPECT_NEAR(o.x, p.x, 1e-6);
+  EXPECT_NEAR(o.y, p.y, 1e-6);
+  EXPECT_NEAR(o.yaw, p.yaw, 1e-6);
+}
+
+TEST(Kinematics, DiffDriveIgnoresSidewaysCommands)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", stiff(diffModel()), Pose2D{0.0, 0.0, kPi / 2});
+  drive(world, id, Twist2D{0.0, 0.4, 0.0}, 1.0);
+  const Pose2D p = world.groundTruth(id);
+  EXPECT_NEAR(p.x, 0.0, 1e-6);
+  EXPECT_NEAR(p.y, 0.0, 1e-6);
+}
+
+TEST(Kinematics, OmniDriveTranslatesAndTurnsAsAnalytic)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", stiff(omniModel()), Pose2D{1.0, -1.0, 0.0});
+  const double vx = 0.2, vy = 0.3, w = 0.5, T = 3.0;
+  drive(world, id, Twist2D{vx, vy, w}, T);
+  const Pose2D p = world.groundTruth(id);
+  // A constant body twist: position = integral of R(w t) (vx, vy) dt.
+  const double s = std::sin(w * T), c = std::cos(w * T);
+  EXPECT_NEAR(p.x, 1.0 + (vx * s + vy * (c - 1.0)) / w, 0.005);
+  EXPECT_NEAR(p.y, -1.0 + (vx * (1.0 - c) + vy * s) / w, 0.005);
+  EXPECT_NEAR(p.yaw, w * T, 0.005);
+  const Pose2D o = world.odometry(id);  // odom starts at identity: the displacement
+  EXPECT_NEAR(o.x, p.x - 1.0, 1e-6);
+  EXPECT_NEAR(o.y, p.y + 1.0, 1e-6);
+}
+
+TEST(Kinematics, AccelerationAndVelocityLimitsHold)
+{
+  World world(openMap(), WorldSettings{});
+  const RobotModel model = diffModel();  // acc 1.0 m/s^2, 3.0 rad/s^2; max 0.5 m/s, 2.0 rad/s
+  const int id = world.addRobot("robot_0", model, Pose2D{});
+  double last_v = 0.0, last_w = 0.0;
+  const double dt = world.physicsStep();
+  for (int i = 0; i < 200; ++i)  // 2 s of a too-fast command
+  {
+    if (i % 10 == 0) world.setCommand(id, Twist2D{5.0, 0.0, 10.0});
+    world.step();
+    const Twist2D v = world.velocity(id);
+    EXPECT_LE(std::abs(v.vx - last_v), model.limits.acc_lim_x * dt + 1e-9) << "step " << i;
+    EXPECT_LE(std::abs(v.wz - last_w), model.limits.acc_lim_theta * dt + 1e-9) << "step " << i;
+    EXPECT_LE(v.vx, model.limits.max_vel_x + 1e-9);
+    EXPECT_LE(v.wz, model.limits.max_vel_theta + 1e-9);
+    last_v = v.vx;
+    last_w = v.wz;
+    if (i == 19)  // after 0.2 s: 0.2 m/s and 0.6 rad/s
+    {
+      EXPECT_NEAR(v.vx, 0.2, 1e-6);
+      EXPECT_NEAR(v.wz, 0.6, 1e-6);
+    }
+  }
+  EXPECT_NEAR(last_v, 0.5, 1e-9);
+  EXPECT_NEAR(last_w, 2.0, 1e-9);
+}
+
+TEST(Kinematics, StraightRunWithRampMatchesTheAnalyticDistance)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{});
+  drive(world, id, Twist2D{0.5, 0.0, 0.0}, 2.0);
+  // 0.5 s ramp at 1 m/s^2 (0.125 m), then 1.5 s at 0.5 m/s: 0.875 m
+  EXPECT_NEAR(world.groundTruth(id).x, 0.875, 0.005);
+  EXPECT_NEAR(world.groundTruth(id).y, 0.0, 1e-9);
+}
+
+TEST(Kinematics, WatchdogStopsARobotWithoutCommands)
+{
+  World world(openMap(), WorldSettings{});  // watchdog 0.2 s
+  const int id = world.addRobot("robot_0", stiff(diffModel()), Pose2D{});
+  world.setCommand(id, Twist2D{0.5, 0.0, 0.0});  // once
+  run(world, 0.1);
+  EXPECT_NEAR(world.velocity(id).vx, 0.5, 1e-9);  // still driving within the timeout
+  run(world, 0.2);
+  EXPECT_NEAR(world.velocity(id).vx, 0.0, 1e-9);
+  const double x = world.groundTruth(id).x;
+  EXPECT_NEAR(x, 0.5 * 0.2, 0.011);  // drove for the 0.2 s of the timeout (+ one step)
+  run(world, 1.0);
+  EXPECT_NEAR(world.groundTruth(id).x, x, 1e-9);  // and stays
+}
+
+// ---- contacts ---------------------------------------------------------------------------------
+
+TEST(Contacts, RobotDrivenIntoAWallStopsAtItAndOneContactIsReported)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{6.0, 1.5, 0.0});  // wall block at x = 7.0
+  const double wall_x = 7.0, radius = 0.15;
+  double max_x = 0.0;
+  for (int i = 0; i < 400; ++i)  // 4 s at 0.5 m/s: would be 2 m, the wall is 0.85 m away
+  {
+    if (i % 10 == 0) world.setCommand(id, Twist2D{0.5, 0.0, 0.0});
+    world.step();
+    max_x = std::max(max_x, world.groundTruth(id).x);
+  }
+  EXPECT_LE(max_x + radius, wall_x) << "the footprint entered the wall";
+  EXPECT_NEAR(world.groundTruth(id).x, wall_x - radius, 0.02) << "stopped short of the wall";
+  EXPECT_NEAR(world.velocity(id).vx, 0.0, 0.01);
+  ASSERT_EQ(rec.contacts.size(), 1u);
+  EXPECT_EQ(rec.contactsBetween("robot_0", "map"), 1);
+  EXPECT_NEAR(rec.contacts[0].x, wall_x, 0.02);
+  // reached the wall after about (0.85 - 0.01 m margin - 0.25 m ramp) / 0.5 + 1.0 s ramp ... ~ 2.2 s
+  EXPECT_GT(rec.contacts[0].stamp, 1.5);
+  EXPECT_LT(rec.contacts[0].stamp, 2.5);
+}
+
+TEST(Contacts, RobotRobotContactIsReportedOnceWhenItStarts)
+{
+  World world(openMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int a = world.addRobot("robot_0", diffModel(), Pose2D{0.0, 0.0, 0.0});
+  world.addRobot("robot_1", diffModel(), Pose2D{1.0, 0.0, 0.0});
+  double first_touch_distance = -1.0;
+  for (int i = 0; i < 400; ++i)
+  {
+    if (i % 10 == 0) world.setCommand(a, Twist2D{0.3, 0.0, 0.0});
+    const size_t before = rec.contacts.size();
+    world.step();
+    if (rec.contacts.size() > before && first_touch_distance < 0)
+      first_touch_distance = world.groundTruth(1).x - world.groundTruth(0).x;
+    // Bodies never pass through each other.
+    EXPECT_GE(world.groundTruth(1).x - world.groundTruth(0).x, 0.3 - 0.005);
+  }
+  EXPECT_EQ(rec.contactsBetween("robot_0", "robot_1"), 1);
+  EXPECT_EQ(rec.contacts.size(), 1u);
+  EXPECT_NEAR(first_touch_distance, 0.32, 0.01);  // 2 radii + 2 contact margins
+  EXPECT_GT(world.groundTruth(1).x, 1.1);         // robot_1 was pushed
+}
+
+TEST(Contacts, MovingObstacleFollowsItsPathAndCannotBePushed)
+{
+  World world(openMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  MovingObstacleConfig person;
+  person.name = "person_1";
+  person.shape.type = ShapeConfig::Type::CYLINDER;
+  person.shape.radius = 0.25;
+  person.waypoints = {{-2.0, 0.0}, {2.0, 0.0}};
+  person.speed = 0.5;
+  person.mode = MovingObstacleConfig::Mode::PING_PONG;
+  world.addMovingObstacle(person);
+  // A robot in the way, driving against the person.
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{1.0, 0.0, kPi});
+  for (int i = 0; i < 600; ++i)  // 6 s: 3 m along the route
+  {
+    if (i % 10 == 0) world.setCommand(id, Twist2D{0.2, 0.0, 0.0});
+    world.step();
+    const ObstacleState s = world.obstacles().front();
+    const double d = 0.5 * world.time();  // path distance; -2 -> 2 takes 8 s
+    EXPECT_NEAR(s.pose.x, -2.0 + d, 1e-6) << "t = " << world.time();
+  }
+  EXPECT_EQ(rec.contactsBetween("robot_0", "person_1"), 1);
+  EXPECT_GT(world.groundTruth(id).x, 1.2);  // pushed back, not through
+  // ping-pong: at 12 s it is back at x = 0, going towards -2
+  run(world, 6.0);
+  EXPECT_NEAR(world.obstacles().front().pose.x, 0.0, 1e-6);
+  EXPECT_NEAR(std::abs(world.obstacles().front().pose.yaw), kPi, 1e-9);
+}
+
+TEST(Contacts, LoopingMoverReturnsToTheFirstWaypoint)
+{
+  World world(openMap(), WorldSettings{});
+  MovingObstacleConfig cart;
+  cart.name = "cart";
+  cart.shape.type = ShapeConfig::Type::BOX;
+  cart.shape.length = 0.6;
+  cart.shape.width = 0.4;
+  cart.waypoints = {{0.0, 0.0}, {3.0, 0.0}, {3.0, 4.0}};  // loop length 3 + 4 + 5 = 12 m
+  cart.speed = 1.0;
+  world.addMovingObstacle(cart);
+  run(world, 5.0);  // 3 m along x, then 2 m up
+  Pose2D p = world.obstacles().front().pose;
+  EXPECT_NEAR(p.x, 3.0, 1e-6);
+  EXPECT_NEAR(p.y, 2.0, 1e-6);
+  EXPECT_NEAR(p.yaw, kPi / 2, 1e-9);
+  run(world, 7.0);
+  p = world.obstacles().front().pose;
+  EXPECT_NEAR(p.x, 0.0, 1e-6);
+  EXPECT_NEAR(p.y, 0.0, 1e-6);
+}
+
+// ---- sensors ----------------------------------------------------------------------------------
+
+TEST(Sensors, LaserSeesWallsRobotsAndObstaclesAtTheirDistance)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int id = world.addRobot("robot_0", model, Pose2D{2.0, 4.0, 0.0});  // laser at x = 2.05
+  world.addRobot("robot_1", model, Pose2D{3.0, 4.0, 0.0});                 // 0.8 m ahead of the laser
+  ObstacleConfig crate;
+  crate.name = "crate";
+  crate.shape.type = ShapeConfig::Type::BOX;
+  crate.shape.length = crate.shape.width = 0.4;
+  crate.pose = Pose2D{2.05, 6.0, 0.0};  // straight left: 2.0 - 0.2 = 1.8 m
+  world.addObstacle(crate);
+  run(world, 0.1);  // the first scan comes one period (0.1 s) after the start
+  ASSERT_EQ(rec.scans[id].size(), 1u);
+  const std::vector<float>& r = rec.scans[id][0].ranges;
+  ASSERT_EQ(r.size(), 360u);
+  EXPECT_NEAR(r[beamAt(model, kPi)], 2.05 - 0.1, 0.05);        // west wall (inner face x = 0.1)
+  EXPECT_NEAR(r[beamAt(model, -kPi / 2)], 4.0 - 0.1, 0.05);    // south wall
+  EXPECT_NEAR(r[beamAt(model, 0.0)], 3.0 - 0.15 - 2.05, 1e-3); // robot_1's body
+  EXPECT_NEAR(r[beamAt(model, kPi / 2)], 1.8, 1e-3);           // the crate
+  // The robot's own body is not seen: no beam is shorter than the walls around it allow.
+  for (float v : r) EXPECT_GT(v, 0.5);
+}
+
+TEST(Sensors, RatesFollowTheModelInSimTime)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  run(world, 2.0);
+  EXPECT_EQ(rec.odom[id].size(), 100u);   // 50 Hz
+  EXPECT_EQ(rec.truth[id].size(), 100u);  // 50 Hz
+  EXPECT_EQ(rec.joints[id].size(), 100u);
+  EXPECT_EQ(rec.scans[id].size(), 20u);   // 10 Hz
+  EXPECT_NEAR(rec.scans[id][1].stamp - rec.scans[id][0].stamp, 0.1, 1e-9);
+  EXPECT_NEAR(rec.odom[id][1].stamp - rec.odom[id][0].stamp, 0.02, 1e-9);
+}
+
+TEST(Sensors, WheelAnglesFollowTheMotion)
+{
+  World world(openMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", stiff(diffModel()), Pose2D{});
+  drive(world, id, Twist2D{0.0, 0.0, 1.0}, 0.5);  // turn in place: wheels turn opposite ways
+  const JointStateSample& j = rec.joints[id].back();
+  ASSERT_EQ(j.position.size(), 2u);
+  // left wheel at y = +0.11 rolls backwards: -w * 0.11 / 0.04 rad/s
+  EXPECT_NEAR(j.velocity[0], -1.0 * 0.11 / 0.04, 1e-6);
+  EXPECT_NEAR(j.velocity[1], 1.0 * 0.11 / 0.04, 1e-6);
+  EXPECT_NEAR(j.position[0], std::remainder(-0.5 * 0.11 / 0.04, 2 * kPi), 0.03);
+}
+
+// ---- determinism and noise --------------------------------------------------------------------
+
+namespace
+{
+struct Trace
+{
+  std::vector<double> values;
+};
+
+Trace noisyRun(unsigned seed)
+{
+  WorldSettings settings;
+  settings.seed = seed;
+  settings.noise = NoiseConfig{0.02, 0.05, 0.05};
+  World world(roomMap(), settings);
+  Recorder rec;
+  world.setListener(&rec);
+  const int a = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  const int b = world.addRobot("robot_1", diffModel(), Pose2D{2.0, 5.0, 0.0});
+  for (int i = 0; i < 300; ++i)
+  {
+    if (i % 10 == 0)
+    {
+      world.setCommand(a, Twist2D{0.3, 0.0, 0.4 * std::sin(i * 0.01)});
+      world.setCommand(b, Twist2D{0.2, 0.0, -0.3});
+    }
+    world.step();
+  }
+  Trace t;
+  for (int id : {a, b})
+  {
+    const Pose2D o = world.odometry(id);
+    t.values.insert(t.values.end(), {o.x, o.y, o.yaw});
+    for (float r : rec.scans[id].back().ranges) t.values.push_back(r);
+  }
+  return t;
+}
+}  // namespace
+
+TEST(Determinism, SameSeedSameTrajectoryAndScans)
+{
+  const Trace first = noisyRun(11), second = noisyRun(11), other = noisyRun(12);
+  ASSERT_EQ(first.values.size(), second.values.size());
+  for (size_t i = 0; i < first.values.size(); ++i) ASSERT_EQ(first.values[i], second.values[i]) << i;
+  size_t differ = 0;
+  for (size_t i = 0; i < first.values.size(); ++i) differ += first.values[i] != other.values[i];
+  EXPECT_GT(differ, first.values.size() / 2) << "another seed should give other noise";
+}
+
+TEST(Noise, LaserNoiseHasTheConfiguredSpread)
+{
+  WorldSettings settings;
+  settings.noise.laser_range = 0.05;
+  World world(roomMap(), settings);
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int id = world.addRobot("robot_0", model, Pose2D{2.0, 4.0, 0.0});
+  run(world, 10.0);  // 100 scans of a robot standing still
+  const size_t beam = beamAt(model, kPi);
+  double sum = 0.0, sum2 = 0.0;
+  for (const auto& s : rec.scans[id])
+  {
+    sum += s.ranges[beam];
+    sum2 += s.ranges[beam] * s.ranges[beam];
+  }
+  const double n = rec.scans[id].size();
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(mean, 1.95, 0.02);
+  EXPECT_NEAR(sd, 0.05, 0.015);
+}
+
+// ---- faults -----------------------------------------------------------------------------------
+
+TEST(Faults, LaserDropoutFractionMatchesTheProbability)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  world.addRobot("robot_0", diffModel(), Pose2D{5.0, 5.0, 0.0});  // every beam hits a wall
+  FaultConfig f;
+  f.laser_dropout = 0.3;
+  world.setFaults("robot_0", f);
+  run(world, 2.0);  // 20 scans, 7200 beams
+  size_t inf = 0, total = 0;
+  for (const auto& s : rec.scans[0])
+    for (float r : s.ranges)
+    {
+      inf += std::isinf(r) && r > 0;
+      ++total;
+    }
+  ASSERT_EQ(total, 7200u);
+  EXPECT_NEAR(static_cast<double>(inf) / total, 0.3, 0.025);  // 4.6 sigma
+}
+
+TEST(Faults, FrozenDriveIgnoresCommands)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{});
+  drive(world, id, Twist2D{0.5, 0.0, 0.0}, 1.0);
+  ASSERT_GT(world.velocity(id).vx, 0.4);
+  FaultConfig f;
+  f.drive_frozen = true;
+  world.setFaults("robot_0", f);
+  const double x = world.groundTruth(id).x;
+  drive(world, id, Twist2D{0.5, 0.0, 1.0}, 1.0);
+  EXPECT_NEAR(world.groundTruth(id).x, x, 1e-9);  // stopped at once: motors failed
+  EXPECT_NEAR(world.velocity(id).vx, 0.0, 1e-12);
+  world.setFaults("robot_0", FaultConfig{});  // cleared: drives again
+  drive(world, id, Twist2D{0.5, 0.0, 0.0}, 1.0);
+  EXPECT_GT(world.groundTruth(id).x, x + 0.2);
+}
+
+TEST(Faults, SilencedRobotPublishesOnlyGroundTruth)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  FaultConfig f;
+  f.silenced = true;
+  world.setFaults("robot_0", f);
+  run(world, 1.0);
+  EXPECT_EQ(rec.odom[id].size(), 0u);
+  EXPECT_EQ(rec.scans[id].size(), 0u);
+  EXPECT_EQ(rec.joints[id].size(), 0u);
+  EXPECT_EQ(rec.truth[id].size(), 50u);
+}
+
+TEST(Faults, LatencyDelaysSamplesButKeepsTheirStamps)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  rec.world = &world;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  FaultConfig f;
+  f.sensor_latency = 0.1;
+  world.setFaults("robot_0", f);
+  run(world, 1.0);
+  ASSERT_EQ(rec.odom[id].size(), 45u);  // 50 measured, the last 5 still on their way
+  for (size_t i = 0; i < rec.odom[id].size(); ++i)
+    EXPECT_NEAR(rec.odom_release_times[i] - rec.odom[id][i].stamp, 0.1, 1e-9);
+  EXPECT_NEAR(rec.odom[id].front().stamp, 0.02, 1e-9);  // the first one period after the start
+}
+
+TEST(Faults, OdometryDriftTurnsTheOdomFrame)
+{
+  World world(openMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{});
+  FaultConfig f;
+  f.odom_drift = 0.05;
+  world.setFaults("robot_0", f);
+  run(world, 2.0);
+  EXPECT_NEAR(world.odometry(id).yaw, 0.1, 1e-6);
+  EXPECT_NEAR(world.groundTruth(id).yaw, 0.0, 1e-9);
+}
+
+// ---- run-time requests ------------------------------------------------------------------------
+
+TEST(Requests, SpawnTeleportRemoveAndTheirErrors)
+{
+  World world(roomMap(), WorldSettings{});
+  const RobotModel model = diffModel();
+  world.addRobot("robot_0", model, Pose2D{2.0, 2.0, 0.0});
+  EXPECT_THROW(world.addRobot("robot_0", model, Pose2D{4.0, 4.0, 0.0}), SimError);  // duplicate
+  EXPECT_THROW(world.addRobot("robot_1", model, Pose2D{0.05, 4.0, 0.0}), SimError);  // in a wall
+  EXPECT_THROW(world.addRobot("robot_1", model, Pose2D{2.2, 2.0, 0.0}), SimError);   // on robot_0
+  EXPECT_THROW(world.addRobot("map", model, Pose2D{4.0, 4.0, 0.0}), SimError);       // the walls' name
+  const int b = world.addRobot("robot_1", model, Pose2D{4.0, 4.0, 0.0});
+  EXPECT_EQ(world.robotCount(), 2u);
+
+  try
+  {
+    world.teleport("robot_1", Pose2D{7.25, 1.0, 0.0});
+    FAIL() << "teleport into a wall must fail";
+  }
+  catch (const SimError& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("would overlap a wall"), std::string::npos) << e.what();
+  }
+  EXPECT_NEAR(world.groundTruth(b).x, 4.0, 1e-9);  // unchanged
+  EXPECT_THROW(world.teleport("robot_9", Pose2D{4.0, 4.0, 0.0}), SimError);
+  world.teleport("robot_1", Pose2D{5.0, 6.0, 1.0});
+  world.step();
+  EXPECT_NEAR(world.groundTruth(b).x, 5.0, 1e-9);
+  EXPECT_NEAR(world.groundTruth(b).yaw, 1.0, 1e-9);
+  EXPECT_NEAR(world.odometry(b).x, 0.0, 1e-9);  // a kidnapping: the wheels did not turn
+
+  FaultConfig bad;
+  bad.laser_dropout = 1.5;
+  EXPECT_THROW(world.setFaults("robot_1", bad), SimError);
+  EXPECT_THROW(world.setFaults("nobody", FaultConfig{}), SimError);
+
+  world.removeRobot("robot_0");
+  EXPECT_EQ(world.robotCount(), 1u);
+  EXPECT_EQ(world.findRobot("robot_0"), -1);
+  EXPECT_THROW(world.removeRobot("robot_0"), SimError);
+  // Its place is free again; a new robot gets a new id.
+  const int c = world.addRobot("robot_0", model, Pose2D{2.0, 2.0, 0.0});
+  EXPECT_EQ(c, 2);
+  world.step();
+}
+
+TEST(Requests, ResetPutsRobotsBackAndZeroesOdometry)
+{
+  World world(roomMap(), WorldSettings{});
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.3});
+  drive(world, id, Twist2D{0.3, 0.0, 0.5}, 2.0);
+  ASSERT_GT(std::hypot(world.odometry(id).x, world.odometry(id).y), 0.3);
+  const double t = world.time();
+  world.resetPositions();
+  world.step();
+  EXPECT_NEAR(world.groundTruth(id).x, 2.0, 1e-9);
+  EXPECT_NEAR(world.groundTruth(id).yaw, 0.3, 1e-9);
+  EXPECT_NEAR(world.odometry(id).x, 0.0, 1e-9);
+  EXPECT_NEAR(world.odometry(id).yaw, 0.0, 1e-9);
+  EXPECT_GT(world.time(), t);  // sim time goes on
+}
+
+TEST(Walls, MergedRectanglesCoverExactlyTheOccupiedCells)
+{
+  const OccupancyMap map = roomMap();
+  const std::vector<CellRect> rects = mergeOccupiedCells(map);
+  std::vector<int> covered(map.data.size(), 0);
+  for (const auto& r : rects)
+    for (unsigned y = r.y; y < r.y + r.height; ++y)
+      for (unsigned x = r.x; x < r.x + r.width; ++x) ++covered[y * map.width + x];
+  for (size_t i = 0; i < map.data.size(); ++i) ASSERT_EQ(covered[i], map.data[i] == 100 ? 1 : 0) << i;
+  EXPECT_LE(rects.size(), 6u);  // 4 walls + the block (+ a split)
+}
+
+// ---- the real models of mbot_description ------------------------------------------------------
+
+TEST(RealModels, MbotOmniBoxBodyStrafesIntoAWallAndStopsAtIt)
+{
+  const RobotModel omni = mbot_description::loadRobotModel(MBOT_DESCRIPTION_DIR, "mbot_omni");
+  const RobotModel mbot = mbot_description::loadRobotModel(MBOT_DESCRIPTION_DIR, "mbot");
+  ASSERT_EQ(omni.drive, DriveType::OMNI);
+  ASSERT_EQ(omni.footprint.size(), 4u);  // a rectangle: a box body
+  double half_width = 0.0;               // footprint extent along y [m]
+  for (const auto& p : omni.footprint) half_width = std::max(half_width, std::abs(p.y));
+
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("omni", omni, Pose2D{3.0, 1.0, 0.0});
+  world.addRobot("round", mbot, Pose2D{5.0, 1.0, 0.0});
+  double min_y = 1.0;
+  for (int i = 0; i < 500; ++i)  // 5 s sideways (right, -y) towards the south wall (y = 0.1)
+  {
+    if (i % 10 == 0) world.setCommand(id, Twist2D{0.0, -0.3, 0.0});
+    world.step();
+    min_y = std::min(min_y, world.groundTruth(id).y);
+  }
+  EXPECT_GE(min_y - half_width, 0.1) << "the box body entered the wall";
+  EXPECT_NEAR(world.groundTruth(id).y, 0.1 + half_width, 0.02);
+  EXPECT_NEAR(world.groundTruth(id).yaw, 0.0, 0.01);  // a flat face against a flat wall: no turn
+  EXPECT_EQ(rec.contactsBetween("omni", "map"), 1);
+  // Its first scan (0.1 s, before it moved away sideways) saw the round robot 2 m ahead, from
+  // the laser mount at laser.mount_x.
+  const std::vector<float>& r = rec.scans[id].front().ranges;
+  EXPECT_NEAR(r[beamAt(omni, 0.0)], 5.0 - 0.15 - (3.0 + omni.laser.mount_x), 0.01);
+}

@@ -1,0 +1,142 @@
+/**
+ * @file test_world_config.cpp
+ * @brief The strict world file reader: a file with every key reads into the right values, and
+ *        each invalid_* fixture fails with a message naming the file, the key and the problem.
+ */
+#include "mbot_sim/world.h"
+#include "mbot_sim/world_config.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+using mbot_sim::MovingObstacleConfig;
+using mbot_sim::ShapeConfig;
+using mbot_sim::WorldConfig;
+using mbot_sim::WorldConfigError;
+
+namespace
+{
+const std::string kFixtures = MBOT_SIM_FIXTURES;
+
+/// A circular robot model like mbot (the geometry tests do not need the URDF).
+mbot_description::RobotModel testModel(const std::string& name)
+{
+  if (name != "mbot" && name != "mbot_omni") throw std::runtime_error("no model named " + name);
+  mbot_description::RobotModel m;
+  m.name = name;
+  m.drive = name == "mbot" ? mbot_description::DriveType::DIFF : mbot_description::DriveType::OMNI;
+  m.footprint_radius = 0.15;
+  m.mass = 2.4;
+  m.wheel_radius = 0.04;
+  m.wheel_separation = 0.22;
+  m.wheel_joints = {"left_wheel_joint", "right_wheel_joint"};
+  return m;
+}
+
+/// The message of reading and building `file`, or "" when it works.
+std::string worldError(const std::string& file)
+{
+  try
+  {
+    const WorldConfig config = mbot_sim::loadWorldConfig(kFixtures + "/" + file);
+    mbot_sim::buildWorld(config, &testModel);
+  }
+  catch (const WorldConfigError& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(WorldConfig, ReadsEveryKey)
+{
+  const WorldConfig c = mbot_sim::loadWorldConfig(kFixtures + "/full.world.yaml");
+  EXPECT_EQ(c.map, kFixtures + "/room.yaml");  // relative to the world file
+  EXPECT_DOUBLE_EQ(c.physics_step, 0.005);
+  EXPECT_DOUBLE_EQ(c.real_time_factor, 0.0);
+  EXPECT_EQ(c.seed, 7u);
+  ASSERT_EQ(c.robots.size(), 2u);
+  EXPECT_EQ(c.robots[0].name, "leader");
+  EXPECT_EQ(c.robots[1].model, "mbot_omni");
+  EXPECT_DOUBLE_EQ(c.robots[1].pose.yaw, -0.5);
+  ASSERT_EQ(c.obstacles.size(), 2u);
+  EXPECT_EQ(c.obstacles[0].shape.type, ShapeConfig::Type::BOX);
+  EXPECT_DOUBLE_EQ(c.obstacles[0].shape.width, 0.4);
+  EXPECT_EQ(c.obstacles[1].name, "obstacle_1");  // unnamed: named by its index
+  EXPECT_DOUBLE_EQ(c.obstacles[1].shape.radius, 0.2);
+  ASSERT_EQ(c.moving_obstacles.size(), 2u);
+  EXPECT_EQ(c.moving_obstacles[0].mode, MovingObstacleConfig::Mode::PING_PONG);
+  EXPECT_EQ(c.moving_obstacles[0].waypoints.size(), 3u);
+  EXPECT_EQ(c.moving_obstacles[1].mode, MovingObstacleConfig::Mode::LOOP);  // the default
+  EXPECT_DOUBLE_EQ(c.noise.odom_angular, 0.03);
+  ASSERT_EQ(c.faults.size(), 1u);
+  EXPECT_EQ(c.faults[0].robot, "follower_1");
+  EXPECT_DOUBLE_EQ(c.faults[0].faults.laser_dropout, 0.1);
+  EXPECT_TRUE(c.faults[0].faults.silenced);
+  EXPECT_FALSE(c.faults[0].faults.drive_frozen);
+
+  auto world = mbot_sim::buildWorld(c, &testModel);
+  EXPECT_EQ(world->robotCount(), 2u);
+  EXPECT_EQ(world->obstacles().size(), 4u);
+  EXPECT_TRUE(world->faults(world->findRobot("follower_1")).silenced);
+}
+
+TEST(WorldConfig, DefaultsWhenOptionalKeysAreMissing)
+{
+  const WorldConfig c = mbot_sim::loadWorldConfig(kFixtures + "/three_robots.world.yaml");
+  EXPECT_EQ(c.robots.size(), 3u);
+  EXPECT_EQ(c.robots[0].model, "mbot");
+  EXPECT_TRUE(c.obstacles.empty());
+  EXPECT_DOUBLE_EQ(c.noise.laser_range, 0.0);
+}
+
+struct InvalidCase
+{
+  std::string file;
+  std::string message;  ///< expected substring, after "<file>: "
+};
+
+TEST(WorldConfig, EachInvalidFixtureGivesItsMessage)
+{
+  const InvalidCase cases[] = {
+      {"invalid_unknown_key.world.yaml", "gravity: unknown key (expected one of map, physics_step"},
+      {"invalid_robot_key.world.yaml", "robots[0].colour: unknown key (expected one of name, model, pose)"},
+      {"invalid_pose_type.world.yaml", "robots[1].pose: expected a list of 3 numbers [x, y, yaw], got \"1.0\""},
+      {"invalid_pose_length.world.yaml", "robots[0].pose: expected a list of 3 numbers [x, y, yaw], got a list of 2"},
+      {"invalid_no_map.world.yaml", "map: missing key (required)"},
+      {"invalid_missing_map.world.yaml", "map: " + kFixtures + "/no_such_map.yaml: cannot read the file"},
+      {"invalid_bad_map.world.yaml", "map: " + kFixtures + "/invalid_header.pgm: bad PGM header"},
+      {"invalid_duplicate_robot.world.yaml", "robots[1].name: duplicate name \"robot_0\""},
+      {"invalid_robot_in_wall.world.yaml", "robots[0].pose: robot robot_0 at (7.20, 1.00) overlaps a wall"},
+      {"invalid_robot_overlap.world.yaml", "robots[1].pose: robot robot_1 at (2.20, 2.00) overlaps robot robot_0"},
+      {"invalid_robot_on_obstacle.world.yaml", "robots[0].pose: robot robot_0 at (2.30, 2.00) overlaps obstacle crate_1"},
+      {"invalid_robot_outside.world.yaml", "robots[0].pose: robot robot_0 at (20.00, 2.00) is outside the map"},
+      {"invalid_model.world.yaml", "robots[0].model: cannot load model \"hovercraft\": no model named hovercraft"},
+      {"invalid_speed.world.yaml", "moving_obstacles[0].speed: expected a number > 0 [m/s], got \"-0.5\""},
+      {"invalid_mode.world.yaml", "moving_obstacles[0].mode: expected loop or ping_pong, got \"bounce\""},
+      {"invalid_shape.world.yaml", "obstacles[0].shape: expected box or cylinder, got \"triangle\""},
+      {"invalid_box_radius.world.yaml", "obstacles[0].radius: a box has a size [length, width], not a radius"},
+      {"invalid_fault_probability.world.yaml", "faults[0].laser_dropout: expected a probability in [0, 1], got 1.5"},
+      {"invalid_fault_robot.world.yaml", "faults[0].robot: no robot named \"robot_9\" in robots"},
+      {"invalid_fault_bool.world.yaml", "faults[0].silenced: expected true or false, got \"1\""},
+      {"invalid_physics_step.world.yaml", "physics_step: expected a number > 0 [s], got \"fast\""},
+      {"invalid_seed.world.yaml", "seed: expected an integer >= 0, got \"1.5\""},
+      {"invalid_rtf.world.yaml", "real_time_factor: expected a number >= 0 (0 = as fast as possible), got \"-2\""},
+      {"invalid_name.world.yaml", "robots[0].name: expected a name of letters, digits and _"},
+      {"invalid_duplicate_key.world.yaml", "seed: duplicate key"},
+      {"invalid_syntax.world.yaml", "not valid YAML"},
+      {"invalid_robots_type.world.yaml", "robots: expected a list, got a map"},
+      {"invalid_noise.world.yaml", "noise.laser_range: expected a number >= 0 [m], got \"-0.01\""},
+      {"invalid_waypoints.world.yaml", "moving_obstacles[0].waypoints: expected a list of at least 2 points"},
+  };
+  for (const auto& c : cases)
+  {
+    const std::string message = worldError(c.file);
+    const std::string expected = kFixtures + "/" + c.file + ": " + c.message;
+    EXPECT_NE(message.find(expected), std::string::npos) << "fixture " << c.file << "\n  got:      " << message
+                                                        << "\n  expected: " << expected;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+  }
+}
