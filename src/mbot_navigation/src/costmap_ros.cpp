@@ -64,7 +64,8 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
     throw std::runtime_error("parameter " + ns + "robots_prediction_cost: expected 0..252 (below INSCRIBED), got " +
                              std::to_string(prediction_cost));
   s.robots.prediction_cost = static_cast<uint8_t>(prediction_cost);
-  if (!(s.robots_padding >= 0.0)) throw std::runtime_error("parameter " + ns + "robots_padding: expected a number >= 0 [m]");
+  if (!(s.robots_padding >= 0.0))
+    throw std::runtime_error("parameter " + ns + "robots_padding: expected a number >= 0 [m]");
   if (!(s.update_frequency > 0.0))
     throw std::runtime_error("parameter " + ns + "update_frequency: expected a number > 0 [Hz]");
   if (!(s.publish_frequency >= 0.0))
@@ -109,7 +110,8 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
 {
   layered_ = std::make_unique<LayeredCostmap>(settings.costmap);
   if (settings.static_map)
-    static_layer_ = static_cast<StaticLayer*>(&layered_->addLayer(std::make_unique<StaticLayer>(settings.static_layer)));
+    static_layer_ =
+        static_cast<StaticLayer*>(&layered_->addLayer(std::make_unique<StaticLayer>(settings.static_layer)));
   if (!settings.scan_topic.empty())
     obstacle_layer_ =
         static_cast<ObstacleLayer*>(&layered_->addLayer(std::make_unique<ObstacleLayer>(settings.obstacle_layer)));

@@ -32,9 +32,23 @@ public:
     : nh_(private_nh), flat_(flat), scoped_(scoped)
   {
   }
-  double getDouble(const std::string& key, double d) { return check(key), scoped_.getDouble(key, flat_.getDouble(key, d)); }
-  int getInt(const std::string& key, int d) { return check(key), scoped_.getInt(key, flat_.getInt(key, d)); }
-  bool getBool(const std::string& key, bool d) { return check(key), scoped_.getBool(key, flat_.getBool(key, d)); }
+  // The flat value (or the default) is the default of the scoped one; both readers mark the key
+  // as known, so that neither reports it as unknown.
+  double getDouble(const std::string& key, double d)
+  {
+    check(key);
+    return scoped_.getDouble(key, flat_.getDouble(key, d));
+  }
+  int getInt(const std::string& key, int d)
+  {
+    check(key);
+    return scoped_.getInt(key, flat_.getInt(key, d));
+  }
+  bool getBool(const std::string& key, bool d)
+  {
+    check(key);
+    return scoped_.getBool(key, flat_.getBool(key, d));
+  }
 
 private:
   void check(const std::string& key) const
@@ -241,7 +255,7 @@ std::vector<TeammateState> TeammateTracker::states(const ros::Time& now) const
 // NavNode: set-up
 
 NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-  : nh_(nh), private_nh_(private_nh), goal_checker_(true)
+  : nh_(nh), private_nh_(private_nh)
 {
   StrictParams p(private_nh_);
   robot_ = localization::robotName(p, nh_);
@@ -330,6 +344,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     op.checkNoUnknown();
   }
   nav.allow_unknown = planner_params.astar.allow_unknown;
+  goal_checker_ = StaticGoalChecker(nav.allow_unknown);  // "unreachable" as the planner sees it
   DwaConfig dwa;
   {
     StrictParams dp(ros::NodeHandle(private_nh_, "DWAPlannerROS"));

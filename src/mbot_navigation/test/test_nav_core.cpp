@@ -207,7 +207,8 @@ TEST(StaticGoalChecker, OutsideObstacleUnreachable)
   ASSERT_TRUE(checker.ready());
 
   const Pose2D start{-5.0, 0.0, 0.0};
-  EXPECT_EQ(checker.check(&start, Pose2D{12.0, 3.0, 0.0}), "goal (12.00, 3.00) is outside the map [-10, 10] x [-10, 10]");
+  EXPECT_EQ(checker.check(&start, Pose2D{12.0, 3.0, 0.0}),
+            "goal (12.00, 3.00) is outside the map [-10, 10] x [-10, 10]");
   EXPECT_EQ(checker.check(&start, Pose2D{-3.0, -10.5, 0.0}),
             "goal (-3.00, -10.50) is outside the map [-10, 10] x [-10, 10]");
   const std::string wall = checker.check(&start, Pose2D{0.0, 1.0, 0.0});

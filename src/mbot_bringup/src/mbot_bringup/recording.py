@@ -45,6 +45,8 @@ class Recording(object):
         self.sample_period = sample_period  # ground-truth sampling [s sim time]
         self.robots = {}
         self.contacts = []                  # dicts: t, a, b, x, y
+        self.goals = []                     # dicts: robot, t, x, y (goals sent to move_base)
+        self.nav_results = []               # dicts: robot, t, status, text
         self.wall_seconds = 0.0
 
     def robot(self, name):
@@ -72,6 +74,12 @@ class Recording(object):
     def add_contact(self, stamp, a, b, x, y):
         self.contacts.append({"t": stamp, "a": a, "b": b, "x": x, "y": y})
 
+    def add_goal(self, name, stamp, x, y):
+        self.goals.append({"robot": name, "t": stamp, "x": x, "y": y})
+
+    def add_nav_result(self, name, stamp, status, text):
+        self.nav_results.append({"robot": name, "t": stamp, "status": status, "text": text})
+
     def sim_seconds(self):
         ends = [tr.t[-1] for tr in self.robots.values() if tr.t]
         starts = [tr.t[0] for tr in self.robots.values() if tr.t]
@@ -88,6 +96,8 @@ class Recording(object):
             lines.append("%-10s %8.1f %8.1f %8.1f %9.2f %9s %8s" % (
                 name, tr.rate("odom"), tr.rate("scan"), tr.rate("ground_truth"),
                 tr.distance(), nearest, final))
+        for r in self.nav_results:
+            lines.append("  %s: goal %s at t=%.1f s %s" % (r["robot"], r["status"], r["t"], r["text"]))
         lines.append("contacts: %d" % len(self.contacts))
         for c in self.contacts[:10]:
             lines.append("  t=%.2f s  %s <-> %s at (%.2f, %.2f)" % (c["t"], c["a"], c["b"], c["x"], c["y"]))
@@ -99,6 +109,8 @@ class Recording(object):
             "sim_seconds": self.sim_seconds(),
             "wall_seconds": self.wall_seconds,
             "contacts": self.contacts,
+            "goals": self.goals,
+            "nav_results": self.nav_results,
             "robots": {
                 name: {"t": tr.t, "x": tr.x, "y": tr.y, "yaw": tr.yaw,
                        "rates": {k: tr.rate(k) for k in tr.counts},

@@ -71,11 +71,13 @@ def plot_trajectories(rec, world_yaml, path):
         ax.plot(r["x"][0], r["y"][0], "o", color=line.get_color())
         ax.annotate("", xy=(r["x"][-1] + 0.3 * math.cos(r["yaw"][-1]), r["y"][-1] + 0.3 * math.sin(r["yaw"][-1])),
                     xytext=(r["x"][-1], r["y"][-1]), arrowprops=dict(arrowstyle="->", color=line.get_color()))
+    for g in rec.get("goals", []):
+        ax.plot(g["x"], g["y"], "k*", ms=10)
     for c in rec["contacts"]:
         ax.plot(c["x"], c["y"], "rx", ms=9)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title("Ground-truth trajectories (o start, arrow end, x contact)")
+    ax.set_title("Ground-truth trajectories (o start, arrow end, * goal, x contact)")
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
@@ -116,6 +118,14 @@ def summary_table(rec):
             "<th>moved [m]</th><th>nearest laser return [m]</th></tr>%s</table>" % "".join(rows))
 
 
+def nav_table(rec):
+    rows = "".join("<tr><td>%s</td><td>%.1f</td><td>%s</td><td style='text-align:left'>%s</td></tr>" % (
+        html.escape(r["robot"]), r["t"], r["status"], html.escape(r["text"])) for r in rec.get("nav_results", []))
+    if not rows:
+        return "<p>No move_base goal finished during the run.</p>"
+    return ("<table><tr><th>robot</th><th>sim time [s]</th><th>result</th><th>status text</th></tr>%s</table>" % rows)
+
+
 def write_report(recording_json, world_yaml, out_dir, screenshot=None):
     """Write out_dir/index.html (plus its images); return the path of index.html."""
     with open(recording_json) as f:
@@ -140,13 +150,14 @@ td,th{border:1px solid #999;padding:0.2em 0.6em;text-align:right}img{max-width:1
 <body><h1>mbot fleet demo</h1>
 <p>World <code>%s</code>: %d robots, %.1f s of sim time in %.1f s of wall time (%.1fx real time).</p>
 <h2>What each robot did</h2>%s
+<h2>Navigation goals</h2>%s
 <h2>Contacts (%d)</h2><ul>%s</ul>
 <h2>Trajectories</h2><img src="trajectories.png" alt="trajectories">
 <h2>Speeds</h2><img src="speeds.png" alt="speeds">
 %s
 </body></html>
 """ % (html.escape(rec.get("world", "")), len(rec["robots"]), rec["sim_seconds"], rec.get("wall_seconds", 0.0),
-       speedup, summary_table(rec), len(rec["contacts"]), contacts or "<li>none</li>", shot)
+       speedup, summary_table(rec), nav_table(rec), len(rec["contacts"]), contacts or "<li>none</li>", shot)
     index = os.path.join(out_dir, "index.html")
     with open(index, "w") as f:
         f.write(page)

@@ -29,6 +29,8 @@ def test_write_report(tmp_path):
     world = make_world(tmp_path)
     rec = {"world": "w", "sim_seconds": 2.0, "wall_seconds": 1.0,
            "contacts": [{"t": 1.0, "a": "robot_0", "b": "map", "x": 0.5, "y": 0.5}],
+           "goals": [{"robot": "robot_0", "t": 0.0, "x": 1.0, "y": 0.0}],
+           "nav_results": [{"robot": "robot_0", "t": 2.0, "status": "ABORTED", "text": "goal is in an obstacle"}],
            "robots": {"robot_0": {"t": [0.0, 1.0, 2.0], "x": [0.0, 0.5, 1.0], "y": [0.0, 0.0, 0.0],
                                   "yaw": [0.0, 0.0, 0.0], "rates": {"odom": 50.0, "scan": 10.0},
                                   "counts": {}, "distance": 1.0, "min_range": 0.4}}}
@@ -40,5 +42,6 @@ def test_write_report(tmp_path):
     assert "2.0x real time" in page
     assert "<td>robot_0</td><td>50.0</td><td>10.0</td>" in page
     assert "robot_0 &harr; map" in page
+    assert "<td>ABORTED</td><td style='text-align:left'>goal is in an obstacle</td>" in page
     for png in ("trajectories.png", "speeds.png"):
         assert os.path.getsize(str(out / png)) > 1000

@@ -45,7 +45,8 @@ def test_world_errors_name_file_and_key(tmp_path):
     with pytest.raises(WorldFileError, match=r"robots\[0\]\.pose: expected a list of 3 numbers"):
         read_world(write(tmp_path, "p.world.yaml", "map: m.yaml\nrobots:\n  - name: a\n    pose: [1, 2]\n"))
     with pytest.raises(WorldFileError, match=r"robots\[1\]\.name"):
-        read_world(write(tmp_path, "n.world.yaml", "map: m.yaml\nrobots:\n  - {name: a, pose: [0, 0, 0]}\n  - {pose: [1, 1, 0]}\n"))
+        read_world(write(tmp_path, "n.world.yaml",
+                         "map: m.yaml\nrobots:\n  - {name: a, pose: [0, 0, 0]}\n  - {pose: [1, 1, 0]}\n"))
     with pytest.raises(WorldFileError, match=r"robots\[0\]\.pose: expected a number"):
         read_world(write(tmp_path, "t.world.yaml", "map: m.yaml\nrobots:\n  - {name: a, pose: [0, x, 0]}\n"))
 

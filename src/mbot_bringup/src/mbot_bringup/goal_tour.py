@@ -1,0 +1,102 @@
+"""goal_tour node: send each robot its list of goals through its move_base action, one after the
+other, and exit when every robot has finished its list (mark it required to end a demo).
+
+Parameters: ~goals (dict robot -> [[x, y, yaw], ...]) or ~goals_file + ~world (a key of the file).
+"""
+import math
+
+import actionlib
+import rospy
+import yaml
+from actionlib_msgs.msg import GoalStatus
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+
+
+# actionlib_msgs/GoalStatus values by name, for messages a person reads.
+STATUS_NAMES = {GoalStatus.PENDING: "PENDING", GoalStatus.ACTIVE: "ACTIVE", GoalStatus.PREEMPTED: "PREEMPTED",
+                GoalStatus.SUCCEEDED: "SUCCEEDED", GoalStatus.ABORTED: "ABORTED", GoalStatus.REJECTED: "REJECTED",
+                GoalStatus.PREEMPTING: "PREEMPTING", GoalStatus.RECALLING: "RECALLING",
+                GoalStatus.RECALLED: "RECALLED", GoalStatus.LOST: "LOST"}
+
+
+def make_goal(x, y, yaw, frame="map"):
+    goal = MoveBaseGoal()
+    goal.target_pose.header.frame_id = frame
+    goal.target_pose.pose.position.x = x
+    goal.target_pose.pose.position.y = y
+    goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
+    goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
+    return goal
+
+
+def load_goals(goals_file, world):
+    """Goals of `world` (a name or a world file path: its base name is the key) from the file."""
+    with open(goals_file) as f:
+        table = yaml.safe_load(f)
+    key = world.split("/")[-1].replace(".world.yaml", "")
+    if key not in table:
+        raise KeyError("%s: no goals for world '%s' (worlds with goals: %s)"
+                       % (goals_file, key, ", ".join(sorted(table))))
+    return table[key]
+
+
+class Tour(object):
+    """One robot working through its goals."""
+
+    def __init__(self, robot, goals):
+        self.robot = robot
+        self.goals = list(goals)
+        self.next = 0
+        self.results = []   # (goal, state name, status text, sim seconds taken)
+        self.client = actionlib.SimpleActionClient("/%s/move_base" % robot, MoveBaseAction)
+        self.sent_at = None
+
+    def done(self):
+        return self.next >= len(self.goals) and self.sent_at is None
+
+    def idle(self):
+        return self.sent_at is None
+
+    def send_next(self):
+        x, y, yaw = self.goals[self.next]
+        self.next += 1
+        self.sent_at = rospy.Time.now()
+        rospy.loginfo("goal_tour: %s -> (%.2f, %.2f, %.2f)", self.robot, x, y, yaw)
+        self.client.send_goal(make_goal(x, y, yaw), done_cb=self.on_done)
+
+    def on_done(self, state, _result):
+        taken = (rospy.Time.now() - self.sent_at).to_sec()
+        goal = self.goals[self.next - 1]
+        name = STATUS_NAMES.get(state, str(state))
+        text = self.client.get_goal_status_text()
+        self.results.append((goal, name, text, taken))
+        rospy.loginfo("goal_tour: %s finished (%.2f, %.2f): %s %s after %.1f s", self.robot,
+                      goal[0], goal[1], name, text, taken)
+        # The next goal is sent from the main loop: a SimpleActionClient must not be given a new
+        # goal from inside its own done callback.
+        self.sent_at = None
+
+
+def main():
+    rospy.init_node("goal_tour")
+    goals = rospy.get_param("~goals", None)
+    if goals is None:
+        goals = load_goals(rospy.get_param("~goals_file"), rospy.get_param("~world"))
+    tours = [Tour(robot, goals[robot]) for robot in sorted(goals)]
+    for tour in tours:
+        if not tour.client.wait_for_server(rospy.Duration(60.0)):
+            rospy.logfatal("goal_tour: /%s/move_base is not there after 60 s of sim time", tour.robot)
+            return 1
+    rate = rospy.Rate(5)
+    try:
+        while not rospy.is_shutdown() and not all(t.done() for t in tours):
+            for tour in tours:
+                if tour.idle() and not tour.done():
+                    tour.send_next()
+            rate.sleep()
+    except rospy.ROSInterruptException:
+        pass  # the launch is shutting down: report what finished
+    for tour in tours:
+        for goal, state, text, taken in tour.results:
+            print("%-10s goal (%6.2f, %6.2f): %-10s %5.1f s  %s" % (tour.robot, goal[0], goal[1], state, taken, text))
+    return 0
