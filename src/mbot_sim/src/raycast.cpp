@@ -37,6 +37,7 @@ constexpr uint8_t kWallCell = 0;
 // A long step is taken when the clearance is at least this [units]. Exact clearances are
 // distances between cells (0, 1, sqrt(2), 2, ...), so 3 units = "not right next to a wall".
 constexpr unsigned kMinLongStep = 3;
+static_assert(kWallCell + 1 < kMinLongStep, "free cells next to a wall (1) must not jump");
 // While walking cell by cell, go back to long steps once a cell's clearance reaches this
 // [units] (3 cells): switching back costs about as much as walking a few cells, so short jumps
 // do not pay. (Measured: 7 to 28 units are within 10% of each other, in the benchmark room and
@@ -657,9 +658,12 @@ int64_t ShapeSet::bucketIndex(double v) const
 
 namespace
 {
+/// One key for a bucket (bx, by): the low 32 bits of each index, side by side.
 inline int64_t packBucketKey(int64_t bx, int64_t by)
 {
-  return (bx << 32) ^ (by & 0xffffffffLL);
+  const uint64_t key =
+      (static_cast<uint64_t>(bx) << 32) | (static_cast<uint64_t>(by) & 0xffffffffu);
+  return static_cast<int64_t>(key);
 }
 }  // namespace
 
