@@ -100,8 +100,9 @@ def publish_for(publisher, msg, seconds, rate_hz=50.0):
     return last
 
 
-def drive_until(publisher, cmd, condition, sim_timeout, rate_hz=20.0):
-    """Publish cmd at rate_hz (sim time) until condition() holds or sim_timeout passes; then a stop.
+def drive_until(publisher, cmd, condition, sim_timeout, rate_hz=20.0, stop=True):
+    """Publish cmd at rate_hz (sim time) until condition() holds or sim_timeout passes; then a
+    stop command unless stop=False.
 
     Robust against this process being starved for a while on a busy machine: the watchdog may
     stop the robot in between, but driving goes on until the condition holds.
@@ -112,7 +113,8 @@ def drive_until(publisher, cmd, condition, sim_timeout, rate_hz=20.0):
     while not rospy.is_shutdown() and not condition() and rospy.get_time() < deadline:
         publisher.publish(cmd)
         rate.sleep()
-    publisher.publish(Twist())
+    if stop:
+        publisher.publish(Twist())
 
 
 def load_pgm_map(yaml_name):

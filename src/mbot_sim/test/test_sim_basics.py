@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """rostest (sim_basics.test): three robots in the room fixture (fixtures/three_robots.world.yaml).
 
-robot_0 is stopped by the watchdog, robot_1 stands and looks at the walls, robot_2 drives into
-the wall block at x = 7.0. All waiting and measuring in sim time. (The 1 m drive, which needs
-exact command timing, is test_sim_drive.py at real-time factor 1.)
+Every robot's rates (from the message stamps); robot_0 is stopped by the watchdog, robot_1
+stands and looks at the walls, robot_2 drives into the wall block at x = 7.0. All waiting and
+measuring in sim time (wall time only while the simulator is paused). The 1 m drive is
+test_sim_drive.py.
 """
 import math
 import sys
+import time
 import unittest
 
 import rospy
@@ -15,7 +17,9 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 from sim_test_tools import (Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
@@ -38,6 +42,11 @@ class SimBasics(unittest.TestCase):
         cls.truth = {n: Recorder("/%s/base_pose_ground_truth" % n, Odometry) for n in ("robot_0", "robot_1", "robot_2")}
         cls.scan1 = Recorder("/robot_1/scan", LaserScan)
         cls.contacts = Recorder("/contacts", Contact)
+        cls.clock = Recorder("/clock", Clock)
+        rospy.wait_for_service("/pause_physics", timeout=30.0)
+        rospy.wait_for_service("/unpause_physics", timeout=30.0)
+        cls.pause = rospy.ServiceProxy("/pause_physics", Empty)
+        cls.unpause = rospy.ServiceProxy("/unpause_physics", Empty)
         cls.cmd = {n: rospy.Publisher("/%s/cmd_vel" % n, Twist, queue_size=10) for n in ("robot_0", "robot_2")}
         for rec in list(cls.truth.values()) + [cls.scan1]:
             rec.wait_for_first()
@@ -67,19 +76,28 @@ class SimBasics(unittest.TestCase):
             rec.sub.unregister()
 
     def test_2_watchdog_stops_the_robot(self):
-        last = publish_for(self.cmd["robot_0"], twist(0.3), 1.0)
-        self.truth["robot_0"].first_stamped_after(last + 2.0, sim_timeout=10.0)
-        speeds = [(m.header.stamp.to_sec(), m.twist.twist.linear.x) for m in self.truth["robot_0"].stamped_after(last - 0.5)]
-        self.assertGreater(len(speeds), 100)
-        stopped_at = next((t for (t, v) in speeds if t > last and abs(v) < 1e-6), None)
+        pub = self.cmd["robot_0"]
+        speed = lambda: self.truth["robot_0"].latest().twist.twist.linear.x  # noqa: E731
+        drive_until(pub, twist(0.3), lambda: speed() > 0.3 - 1e-6, 10.0, stop=False)
+        self.assertGreater(speed(), 0.3 - 1e-6)
+        # The last command is sent while the simulator is paused, so it arrives at a sim time
+        # this test knows exactly (however late this process runs): the paused clock.
+        self.pause()
+        time.sleep(0.5)  # wall time: sim time stands still now
+        paused_at = self.clock.latest().clock.to_sec()
+        pub.publish(twist(0.3))
+        time.sleep(1.0)  # wall: delivered while paused
+        self.assertEqual(self.clock.latest().clock.to_sec(), paused_at, "sim time moved while paused")
+        self.unpause()
+        self.truth["robot_0"].first_stamped_after(paused_at + 2.0, sim_timeout=10.0)
+        speeds = [(m.header.stamp.to_sec(), m.twist.twist.linear.x) for m in self.truth["robot_0"].stamped_after(paused_at)]
+        stopped_at = next((t for (t, v) in speeds if abs(v) < 1e-6), None)
         self.assertIsNotNone(stopped_at, "the robot never stopped")
         braking_from = max(t for (t, v) in speeds if t < stopped_at and v > 0.3 - 1e-6)
-        # braking from 0.3 m/s at 1 m/s^2 takes 0.3 s
-        self.assertAlmostEqual(stopped_at - braking_from, 0.3, delta=0.045)  # 50 Hz samples
-        # The last command reached the simulator at sim time >= `last` (the test's clock may lag
-        # the simulator's): the robot drives on for the 0.2 s watchdog timeout, then brakes.
-        self.assertGreater(stopped_at - last, 0.49)
-        self.assertLess(stopped_at - last, 1.0)
+        # 0.2 s watchdog timeout at full speed, then braking from 0.3 m/s at 1 m/s^2 for 0.3 s
+        # (ground truth comes at 50 Hz: +0.02 s)
+        self.assertAlmostEqual(braking_from - paused_at, 0.2, delta=0.025)
+        self.assertAlmostEqual(stopped_at - paused_at, 0.5, delta=0.035)
         for (t, v) in speeds:
             if t > stopped_at:
                 self.assertLess(abs(v), 1e-6, "moved again at t = %.2f" % t)
@@ -118,7 +136,8 @@ class SimBasics(unittest.TestCase):
         ly = base.position.y + math.sin(yaw) * mount.x + math.cos(yaw) * mount.y
         occupied, res, ox, oy, _, _ = load_pgm_map("room.yaml")
         checked = 0
-        for index in (0, 90, 270):  # west (-pi), south (-pi/2), north (+pi/2)
+        # west (-pi), east (0), north (+pi/2); south would see robot_0, 2 m away at the start
+        for index in (0, 180, 270):
             angle = yaw + scan.angle_min + index * scan.angle_increment
             expected = map_range(occupied, res, ox, oy, lx, ly, angle, scan.range_max)
             self.assertTrue(math.isfinite(expected))
