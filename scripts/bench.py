@@ -1,7 +1,9 @@
 """Run the project's benchmarks and report them as a table and JSON.
 
     scripts/bench sim [--json FILE]   simulator real-time factor for N robots, ray casting rate
-    scripts/bench nav [--json FILE]   global plan time and length, DWA cycle time
+    scripts/bench nav [--json FILE]   global plan time and length, DWA cycle time, and the
+                                      seeded random-goal navigation trial in `office`
+        --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 5)
     scripts/bench all [--json FILE]
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
@@ -68,7 +70,24 @@ def bench_sim():
     return {"rtf": rtf, "rays_per_second": rays["rays_per_second"], "sim_runs": details}
 
 
-def bench_nav():
+def nav_trial(runs, rtf):
+    """Seeded random-goal trial: one robot in `office`, each run one goal with a timeout.
+
+    It runs the whole ROS stack (simulator, map server, localization, nav node), so it cannot be
+    pinned to one core. At real_time_factor 0 the simulator outruns the 20 Hz controller (there is
+    no lockstep yet), so the trial runs at a fixed factor the stack can follow on 2 cores.
+    """
+    script = os.path.join(ROOT, "src", "mbot_navigation", "scripts", "nav_trial")
+    print("$ nav_trial --runs %d --seed 1 --real-time-factor %g --json" % (runs, rtf), file=sys.stderr)
+    out = subprocess.run(["/usr/bin/python3", script, "--runs", str(runs), "--seed", "1",
+                          "--real-time-factor", str(rtf), "--json"],
+                         check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
+    result = json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
+    result["real_time_factor"] = rtf
+    return result
+
+
+def bench_nav(trial_runs=100, trial_rtf=5.0):
     plan = {}
     for n in ("1000", "2000"):
         r = run_json([program("mbot_navigation", "plan_bench"),
@@ -76,7 +95,10 @@ def bench_nav():
                       "--pairs", os.path.join(SHARED_BENCH, "pairs_%s.csv" % n), "--json"])
         plan[n] = {k: r[k] for k in ("p50", "p95", "mean_path_cells", "failures")}
     dwa = run_json([program("mbot_navigation", "dwa_bench")])
-    return {"plan_ms": plan, "dwa_ms": {"p50": dwa["p50"], "p99": dwa["p99"]}}
+    result = {"plan_ms": plan, "dwa_ms": {"p50": dwa["p50"], "p99": dwa["p99"]}}
+    if trial_runs > 0:
+        result["trial"] = nav_trial(trial_runs, trial_rtf)
+    return result
 
 
 def print_table(result):
@@ -93,18 +115,25 @@ def print_table(result):
             print("  %-10s %8.2f %8.2f %12.1f %9d" % (n + "^2", r["p50"], r["p95"],
                                                      r["mean_path_cells"], r["failures"]))
         print("\nDWA cycle: p50 %.2f ms, p99 %.2f ms" % (result["dwa_ms"]["p50"], result["dwa_ms"]["p99"]))
+    if "trial" in result:
+        t = result["trial"]
+        print("\nNavigation trial (office, real_time_factor %g): %d of %d goals reached, %d contacts, "
+              "%.0f sim s in %.0f wall s" % (t["real_time_factor"], t["succeeded"], t["runs"], t["contacts"],
+                                             t["sim_seconds"], t["wall_seconds"]))
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("what", choices=["sim", "nav", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
+    parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
+    parser.add_argument("--trial-rtf", type=float, default=5.0, help="real-time factor of the trial")
     args = parser.parse_args(argv)
     result = {}
     if args.what in ("sim", "all"):
         result.update(bench_sim())
     if args.what in ("nav", "all"):
-        result.update(bench_nav())
+        result.update(bench_nav(args.trial_runs, args.trial_rtf))
     result["machine"] = machine()
     print_table(result)
     if args.json:
