@@ -76,6 +76,16 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
     throw StartupError(pnh.resolveName("base_watchdog_timeout") + ": expected a number > 0 [s]");
   pnh.param("marker_rate", p.marker_rate, 10.0);
   if (!(p.marker_rate > 0.0)) throw StartupError(pnh.resolveName("marker_rate") + ": expected a number > 0 [Hz]");
+  pnh.param("lockstep", p.lockstep, false);
+  pnh.param("lockstep_period", p.lockstep_period, 0.05);
+  if (!(p.lockstep_period > 0.0))
+    throw StartupError(pnh.resolveName("lockstep_period") + ": expected a number > 0 [s]");
+  pnh.param("lockstep_active_timeout", p.lockstep_active_timeout, 0.5);
+  if (!(p.lockstep_active_timeout > 0.0))
+    throw StartupError(pnh.resolveName("lockstep_active_timeout") + ": expected a number > 0 [s]");
+  pnh.param("lockstep_wall_timeout", p.lockstep_wall_timeout, 0.5);
+  if (!(p.lockstep_wall_timeout > 0.0))
+    throw StartupError(pnh.resolveName("lockstep_wall_timeout") + ": expected a number > 0 [s]");
   return p;
 }
 
@@ -144,6 +154,10 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
            path.c_str(), world_->robotCount(), world_->obstacles().size(), world_->wallBoxCount(),
            world_->physicsStep(), real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "",
            config.seed);
+  if (params_.lockstep)
+    ROS_INFO("stage_node: lockstep: sim time waits for the driven robots' cmd_vel every %g s sim time "
+             "(driven: a cmd_vel within %g s sim time; at most %g s wall per wait)",
+             params_.lockstep_period, params_.lockstep_active_timeout, params_.lockstep_wall_timeout);
 }
 
 const mbot_description::RobotModel& StageRos::model(const std::string& name)
@@ -251,6 +265,70 @@ void StageRos::publishClock()
   clock_pub_.publish(clock);
 }
 
+/// Lockstep: after a step, note whether /clock just reached (or crossed) a period boundary.
+void StageRos::noteBoundary()
+{
+  const double now = world_->time();
+  if (now + 1e-9 < next_boundary_) return;
+  ++boundary_count_;
+  next_boundary_ = (std::floor((now + 1e-9) / params_.lockstep_period) + 1.0) * params_.lockstep_period;
+  boundary_wait_pending_ = true;
+}
+
+/// Lockstep: before stepping past the boundary just published (number n), wait until every
+/// driven robot has sent a cmd_vel that arrived after boundary n-1 was published and has not
+/// released a boundary yet. "After n-1" (not "after n") lets a controller whose timer ticks between
+/// two boundaries (any phase) answer in time, so at real-time factors the controller keeps up with
+/// it rarely waits; "one cmd_vel, one boundary" keeps sim time at most one period (+ one physics
+/// step) ahead of the controller's last cycle. Callbacks and services are served while waiting.
+/// After ~lockstep_wall_timeout the robots that did not answer count as not driven until their
+/// next cmd_vel, so a dead controller costs one timeout, not one per boundary.
+/// @return false when paused or shut down while waiting (the wait is still pending)
+bool StageRos::waitForControllers()
+{
+  ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.lockstep_wall_timeout);
+  const auto waitingFor = [this](const RobotIo& io) {
+    const bool driven = world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout;
+    const bool answered = io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1;
+    return driven && !answered;
+  };
+  while (true)
+  {
+    if (!ros::ok() || paused_) return false;
+    bool all_answered = true;
+    for (const auto& io : io_)
+      if (io && waitingFor(*io)) all_answered = false;
+    if (all_answered) break;
+    if (ros::WallTime::now() >= deadline)
+    {
+      std::string late;
+      for (auto& io : io_)
+        if (io && waitingFor(*io))
+        {
+          late += (late.empty() ? "" : ", ") + io->name;
+          io->last_cmd_time = -1e9;  // not driven until its next cmd_vel
+        }
+      ++lockstep_timeouts_;
+      const ros::WallTime wall_now = ros::WallTime::now();
+      if ((wall_now - last_lockstep_warning_).toSec() >= 5.0)  // throttled: a slow controller times out often
+      {
+        ROS_WARN("stage_node: lockstep: no cmd_vel from %s within %g s wall at sim time %.3f s: going on "
+                 "(%ld such timeouts since the last warning)",
+                 late.c_str(), params_.lockstep_wall_timeout, world_->time(), lockstep_timeouts_);
+        last_lockstep_warning_ = wall_now;
+        lockstep_timeouts_ = 0;
+      }
+      break;
+    }
+    queue.callAvailable(ros::WallDuration(0.001));  // sleeps until a callback is ready, at most 1 ms
+  }
+  for (auto& io : io_)  // each cmd_vel releases one boundary
+    if (io && io->cmd_boundary >= boundary_count_ - 1) io->cmd_unused = false;
+  boundary_wait_pending_ = false;
+  return true;
+}
+
 void StageRos::run()
 {
   ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
@@ -258,6 +336,7 @@ void StageRos::run()
   double anchor_sim = world_->time();
   bool has_movers = false;
   for (const auto& o : world_->obstacles()) has_movers = has_movers || o.moving;
+  next_boundary_ = (std::floor(world_->time() / params_.lockstep_period) + 1.0) * params_.lockstep_period;
 
   while (ros::ok())
   {
@@ -274,6 +353,7 @@ void StageRos::run()
       anchor_sim = world_->time();
       pacing_reset_ = false;
     }
+    if (boundary_wait_pending_ && !waitForControllers()) continue;  // paused or shut down meanwhile
 
     world_->step();  // calls the on*() listeners, which publish
     if (!tf_batch_.empty())
@@ -282,6 +362,7 @@ void StageRos::run()
       tf_batch_.clear();
     }
     publishClock();
+    if (params_.lockstep) noteBoundary();
     if (has_movers && world_->time() + 1e-9 >= next_marker_time_)
     {
       publishMarkers();
@@ -359,6 +440,9 @@ void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
 {
   if (!world_->hasRobot(robot)) return;  // removed while the message waited
   world_->setCommand(robot, Twist2D{msg->linear.x, msg->linear.y, msg->angular.z});
+  io_[robot]->last_cmd_time = world_->time();
+  io_[robot]->cmd_boundary = boundary_count_;
+  io_[robot]->cmd_unused = true;
 }
 
 void StageRos::onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg)

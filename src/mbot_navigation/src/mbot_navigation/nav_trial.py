@@ -109,7 +109,8 @@ def run(args, log):
     os.environ.pop("ROS_IP", None)
     launch = ["roslaunch", "-p", str(port), "mbot_navigation", "fleet_navigation.launch",
               "world:=" + os.path.abspath(args.world), "real_time_factor:=%g" % args.real_time_factor,
-              "seed:=%d" % args.seed, "localization:=" + args.localization]
+              "seed:=%d" % args.seed, "localization:=" + args.localization,
+              "lockstep:=true"]  # sim time never runs ahead of the nav nodes, at any real-time factor
     log("starting: %s" % " ".join(launch))
     with open(args.launch_log, "w") as launch_log:
         process = subprocess.Popen(launch, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)

@@ -49,6 +49,11 @@ struct StageParams
   int seed = 0;                    ///< ~seed: overrides the world file's when set
   double watchdog_timeout = 0.2;   ///< ~base_watchdog_timeout [s sim time]
   double marker_rate = 10.0;       ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+  bool lockstep = false;           ///< ~lockstep: hold sim time at period boundaries for the controllers
+  double lockstep_period = 0.05;   ///< ~lockstep_period: distance of the boundaries [s sim time]
+  double lockstep_active_timeout = 0.5;  ///< ~lockstep_active_timeout: a robot is driven while its
+                                         ///< last cmd_vel is at most this old [s sim time]
+  double lockstep_wall_timeout = 0.5;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
@@ -69,6 +74,8 @@ public:
 
   /// @brief Step the world until shutdown, paced by the real-time factor (0: as fast as
   ///        possible); callbacks and services are served between steps, on this thread.
+  ///        With ~lockstep, sim time also waits for the driven robots' controllers at every
+  ///        ~lockstep_period boundary (see waitForControllers()).
   void run();
 
   // SensorListener: called by World::step()
@@ -90,6 +97,9 @@ private:
     sensor_msgs::LaserScan scan_msg;
     sensor_msgs::JointState joint_msg;
     geometry_msgs::TransformStamped odom_tf;
+    double last_cmd_time = -1e9;  ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
+    long cmd_boundary = -1;       ///< boundary_count_ when the last cmd_vel arrived
+    bool cmd_unused = false;      ///< lockstep: the last cmd_vel has not released a boundary yet
   };
 
   const mbot_description::RobotModel& model(const std::string& name);
@@ -97,6 +107,8 @@ private:
   void publishRobotList();
   void publishMarkers();
   void publishClock();
+  void noteBoundary();
+  bool waitForControllers();
 
   void onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg);
   void onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg);
@@ -123,6 +135,13 @@ private:
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
   double next_marker_time_ = 0.0;
+
+  // lockstep (see waitForControllers())
+  long boundary_count_ = 0;           ///< boundaries published so far
+  double next_boundary_ = 0.0;        ///< sim time of the next boundary [s]
+  bool boundary_wait_pending_ = false;  ///< a boundary was published and not yet waited at
+  long lockstep_timeouts_ = 0;        ///< wall timeouts since the last warning
+  ros::WallTime last_lockstep_warning_;
 };
 
 }  // namespace mbot_sim

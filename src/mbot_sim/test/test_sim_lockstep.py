@@ -1,0 +1,110 @@
+#!/usr/bin/python3
+"""rostest (sim_lockstep.test): stage_node's lockstep at real_time_factor 0.
+
+A deliberately slow controller answers every /clock advance past a lockstep boundary with a
+cmd_vel for robot_0, 20 ms (wall) after it saw the boundary. stage_node, which runs about 800x
+faster than real time without lockstep, must hold sim time for it: one cmd_vel releases one
+boundary, so while the test drives, sim time never gets more than one period (+ one physics step,
+for a boundary between two steps) past the last boundary the test answered. Without lockstep sim time runs seconds ahead within the 20 ms.
+When the test stops sending, robot_0 is no longer waited for: sim time runs on (> 5 s sim within
+a few wall seconds), it does not hang.
+"""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+import yaml
+from geometry_msgs.msg import Twist
+from rosgraph_msgs.msg import Clock
+
+ANSWER_DELAY = 0.02  # [s wall] how long the controller "computes"
+ANSWERS = 40         # boundaries answered while driving
+
+
+class ClockWatch(object):
+    """The latest /clock and the largest lead of sim time over the last answered boundary."""
+
+    def __init__(self, limit):
+        self.lock = threading.Lock()
+        self.limit = limit  # allowed lead [s sim]
+        self.latest = None
+        self.last_answered = None  # None: not driving, nothing is checked
+        self.worst_lead = 0.0
+        self.violations = []
+        rospy.Subscriber("/clock", Clock, self._callback, queue_size=1, tcp_nodelay=True)
+
+    def _callback(self, msg):
+        t = msg.clock.to_sec()
+        with self.lock:
+            self.latest = t
+            if self.last_answered is not None:
+                lead = t - self.last_answered
+                self.worst_lead = max(self.worst_lead, lead)
+                if lead > self.limit:
+                    self.violations.append((self.last_answered, t))
+
+    def now(self):
+        with self.lock:
+            return self.latest
+
+
+def wait_for(condition, wall_timeout, what):
+    deadline = time.time() + wall_timeout
+    while not condition():
+        if time.time() > deadline:
+            raise AssertionError("timed out after %.1f s wall waiting for %s" % (wall_timeout, what))
+        time.sleep(0.001)
+
+
+class SimLockstep(unittest.TestCase):
+    def test_slow_controller_holds_sim_time_and_release(self):
+        rospy.init_node("test_sim_lockstep")
+        period = rospy.get_param("/stage_node/lockstep_period")
+        with open(rospy.get_param("/stage_node/world")) as f:
+            step = yaml.safe_load(f)["physics_step"]
+        limit = period + step + 1e-6
+        watch = ClockWatch(limit)
+        pub = rospy.Publisher("/robot_0/cmd_vel", Twist, queue_size=10, tcp_nodelay=True)
+        wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
+        boundary = lambda: math.floor(watch.now() / period + 1e-6) * period  # noqa: E731
+
+        # Start driving; the first command makes robot_0 driven, from then on sim time waits.
+        pub.publish(Twist())
+        time.sleep(0.1)
+
+        answered = None
+        wall_start = time.time()
+        sim_start = watch.now()
+        for _ in range(ANSWERS):
+            wait_for(lambda: answered is None or boundary() > answered + 1e-6, 2.0, "sim time to pass a boundary")
+            b = boundary()
+            time.sleep(ANSWER_DELAY)
+            answered = b
+            with watch.lock:  # before publishing: the sim cannot move on before it gets it
+                watch.last_answered = b
+            pub.publish(Twist())
+        sim_driven = watch.now() - sim_start
+        wall_driven = time.time() - wall_start
+        with watch.lock:
+            watch.last_answered = None
+            violations, worst = list(watch.violations), watch.worst_lead
+        print("driving: %.2f s sim in %.2f s wall (%d answers); largest lead over the last answer %.3f s "
+              "(allowed %.3f s)" % (sim_driven, wall_driven, ANSWERS, worst, limit))
+        self.assertEqual(len(violations), 0, "sim time ran ahead of the answered boundary (answered, sim time): %s"
+                         % violations[:5])
+        # Each answer released about one period: sim time moved on, but only that far.
+        self.assertGreater(sim_driven, (ANSWERS - 5) * period)
+        self.assertLess(sim_driven, (ANSWERS + 3) * period)
+
+        # Stop sending: after one wall timeout robot_0 is not waited for any more.
+        t0, w0 = watch.now(), time.time()
+        wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after the commands stopped")
+        print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_sim", "sim_lockstep", SimLockstep, sys.argv)
