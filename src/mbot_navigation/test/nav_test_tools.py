@@ -43,6 +43,17 @@ def wait_until(condition, timeout, what):
     raise AssertionError("timed out after %.0f sim s waiting for %s" % (timeout, what))
 
 
+def wait_for_wall(condition, timeout, what):
+    """Poll `condition` on the wall clock, for tests that publish /clock themselves (sim time
+    only moves when the test publishes it)."""
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        if condition():
+            return
+        time.sleep(0.01)
+    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
+
+
 def action_client(robot, timeout=60.0):
     """A connected SimpleActionClient for /<robot>/move_base (the server starts once the nav node
     has the map and the robot's pose). Waits `timeout` wall seconds: the nodes start in wall time,

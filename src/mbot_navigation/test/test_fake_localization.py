@@ -20,6 +20,8 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
+from nav_test_tools import wait_for_wall as wait_for
+
 PKG = "mbot_navigation"
 STEPS = 25
 STEP_NS = 20 * 1000 * 1000  # 50 Hz
@@ -46,15 +48,6 @@ def homogeneous(x, y, z, q):
     m[:3, 3] = (x, y, z)
     return m
 
-
-def wait_for(condition, timeout, what):
-    """Poll `condition` on the wall clock (sim time only moves when this test publishes it)."""
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        if condition():
-            return
-        time.sleep(0.01)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
 
 
 def ground_truth(k):

@@ -22,6 +22,8 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
+from nav_test_tools import wait_for_wall as wait_for
+
 PKG = "mbot_navigation"
 RESOLUTION = 0.05  # [m/cell]
 ORIGIN = (-0.5, -0.25)  # [m]
@@ -79,14 +81,6 @@ def yaw_of(q):
 def set_yaw(q, yaw):
     q.x, q.y, q.z, q.w = 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
-
-def wait_for(condition, timeout, what):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        if condition():
-            return
-        time.sleep(0.01)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
 
 
 class PfLocalizationTest(unittest.TestCase):

@@ -123,25 +123,11 @@ def load_pgm_map(yaml_name):
     Reads the map_server yaml and the binary PGM with the map_server rules (negate 0, p > occupied).
     """
     import yaml
+    from mbot_sim.map_io import read_pgm
     with open(os.path.join(FIXTURES, yaml_name)) as f:
         info = yaml.safe_load(f)
-    with open(os.path.join(FIXTURES, info["image"]), "rb") as f:
-        data = f.read()
-    tokens, pos = [], 0
-    while len(tokens) < 4:
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        if data[pos:pos + 1] == b"#":
-            while data[pos:pos + 1] != b"\n":
-                pos += 1
-            continue
-        start = pos
-        while not data[pos:pos + 1].isspace():
-            pos += 1
-        tokens.append(data[start:pos])
-    assert tokens[0] == b"P5"
-    width, height = int(tokens[1]), int(tokens[2])
-    pixels = data[pos + 1:pos + 1 + width * height]
+    image = read_pgm(os.path.join(FIXTURES, info["image"]))  # top row first
+    height, width = image.shape
     res = float(info["resolution"])
     ox, oy = float(info["origin"][0]), float(info["origin"][1])
     thresh = float(info["occupied_thresh"])
@@ -149,7 +135,7 @@ def load_pgm_map(yaml_name):
     def occupied(ix, iy):
         if ix < 0 or iy < 0 or ix >= width or iy >= height:
             return False
-        value = pixels[(height - 1 - iy) * width + ix]  # map row 0 is the image's bottom row
+        value = int(image[height - 1 - iy, ix])  # map row 0 is the image's bottom row
         return (255 - value) / 255.0 > thresh
 
     return occupied, res, ox, oy, width, height
