@@ -86,6 +86,9 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   pnh.param("lockstep_wall_timeout", p.lockstep_wall_timeout, 0.5);
   if (!(p.lockstep_wall_timeout > 0.0))
     throw StartupError(pnh.resolveName("lockstep_wall_timeout") + ": expected a number > 0 [s]");
+  pnh.param("lockstep_localization_lag", p.lockstep_localization_lag, 0.1);
+  if (!(p.lockstep_localization_lag >= 0.0))
+    throw StartupError(pnh.resolveName("lockstep_localization_lag") + ": expected a number >= 0 [s]");
   return p;
 }
 
@@ -148,6 +151,8 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   services_.push_back(nh_.advertiseService("teleport_robot", &StageRos::onTeleport, this));
   services_.push_back(nh_.advertiseService("set_fault", &StageRos::onSetFault, this));
   world_->setListener(this);
+  if (params_.lockstep)  // only then: every /tf message costs this node a callback
+    tf_sub_ = nh_.subscribe("/tf", 1000, &StageRos::onTf, this, ros::TransportHints().tcpNoDelay());
 
   ROS_INFO("stage_node: world %s: %zu robots, %zu obstacles, map walls as %zu boxes, physics step %.3f s, "
            "real-time factor %g%s, seed %u",
@@ -155,9 +160,11 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
            world_->physicsStep(), real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "",
            config.seed);
   if (params_.lockstep)
-    ROS_INFO("stage_node: lockstep: sim time waits for the driven robots' cmd_vel every %g s sim time "
-             "(driven: a cmd_vel within %g s sim time; at most %g s wall per wait)",
-             params_.lockstep_period, params_.lockstep_active_timeout, params_.lockstep_wall_timeout);
+    ROS_INFO("stage_node: lockstep: sim time waits for the driven robots' cmd_vel and localization every %g s "
+             "sim time (driven: a cmd_vel within %g s sim time; localization lag up to %g s sim time; at most %g s "
+             "wall per wait)",
+             params_.lockstep_period, params_.lockstep_active_timeout, params_.lockstep_localization_lag,
+             params_.lockstep_wall_timeout);
 }
 
 const mbot_description::RobotModel& StageRos::model(const std::string& name)
@@ -281,18 +288,30 @@ void StageRos::noteBoundary()
 /// two boundaries (any phase) answer in time, so at real-time factors the controller keeps up with
 /// it rarely waits; "one cmd_vel, one boundary" keeps sim time at most one period (+ one physics
 /// step) ahead of the controller's last cycle. Callbacks and services are served while waiting.
-/// After ~lockstep_wall_timeout the robots that did not answer count as not driven until their
-/// next cmd_vel, so a dead controller costs one timeout, not one per boundary.
+/// Every robot whose localization publishes map -> <ns>/odom on /tf (driven or not) is also waited
+/// for until that transform is at most ~lockstep_localization_lag behind sim time: otherwise sim
+/// time runs away from a localization that cannot keep up (between goals, when no robot is driven,
+/// or when a controller answers at once with a stop, as move_base does without a fresh pose) and
+/// the robot never gets a fresh pose again.
+/// After ~lockstep_wall_timeout the robots whose controller did not answer count as not driven
+/// until their next cmd_vel, and a localization still behind is not waited for until it has caught
+/// up by itself, so a dead controller or localization costs one timeout, not one per boundary.
 /// @return false when paused or shut down while waiting (the wait is still pending)
 bool StageRos::waitForControllers()
 {
   ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.lockstep_wall_timeout);
-  const auto waitingFor = [this](const RobotIo& io) {
-    const bool driven = world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout;
-    const bool answered = io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1;
-    return driven && !answered;
+  const auto driven = [this](const RobotIo& io) {
+    return world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout;
   };
+  const auto answered = [this](const RobotIo& io) {
+    return io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1;
+  };
+  const auto localized = [this](const RobotIo& io) {
+    return io.localization_ignored || io.localization_stamp < -1e8 ||  // none seen: nothing to wait for
+           localizationCurrent(io);
+  };
+  const auto waitingFor = [&](const RobotIo& io) { return (driven(io) && !answered(io)) || !localized(io); };
   while (true)
   {
     if (!ros::ok() || paused_) return false;
@@ -306,14 +325,23 @@ bool StageRos::waitForControllers()
       for (auto& io : io_)
         if (io && waitingFor(*io))
         {
-          late += (late.empty() ? "" : ", ") + io->name;
-          io->last_cmd_time = -1e9;  // not driven until its next cmd_vel
+          if (driven(*io) && !answered(*io))
+          {
+            late += (late.empty() ? "" : ", ") + io->name + " (no cmd_vel)";
+            io->last_cmd_time = -1e9;  // not driven until its next cmd_vel
+          }
+          if (!localized(*io))
+          {
+            late += (late.empty() ? "" : ", ") + io->name + " (localization " +
+                    std::to_string(world_->time() - io->localization_stamp) + " s behind)";
+            io->localization_ignored = true;
+          }
         }
       ++lockstep_timeouts_;
       const ros::WallTime wall_now = ros::WallTime::now();
       if ((wall_now - last_lockstep_warning_).toSec() >= 5.0)  // throttled: a slow controller times out often
       {
-        ROS_WARN("stage_node: lockstep: no cmd_vel from %s within %g s wall at sim time %.3f s: going on "
+        ROS_WARN("stage_node: lockstep: waited for %s for %g s wall at sim time %.3f s: going on "
                  "(%ld such timeouts since the last warning)",
                  late.c_str(), params_.lockstep_wall_timeout, world_->time(), lockstep_timeouts_);
         last_lockstep_warning_ = wall_now;
@@ -443,6 +471,28 @@ void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
   io_[robot]->last_cmd_time = world_->time();
   io_[robot]->cmd_boundary = boundary_count_;
   io_[robot]->cmd_unused = true;
+}
+
+bool StageRos::localizationCurrent(const RobotIo& io) const
+{
+  return io.localization_stamp + params_.lockstep_localization_lag >= world_->time() - 1e-9;
+}
+
+/// Lockstep: the newest stamp of each robot's localization output, a transform to <ns>/odom.
+void StageRos::onTf(const tf2_msgs::TFMessage::ConstPtr& msg)
+{
+  static const std::string suffix = "/odom";
+  for (const auto& t : msg->transforms)
+  {
+    const std::string& child = t.child_frame_id;
+    if (child.size() <= suffix.size() || child.compare(child.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const int robot = world_->findRobot(child.substr(0, child.size() - suffix.size()));
+    if (robot < 0 || robot >= static_cast<int>(io_.size()) || !io_[robot]) continue;
+    RobotIo& io = *io_[robot];
+    io.localization_stamp = std::max(io.localization_stamp, t.header.stamp.toSec());
+    if (io.localization_ignored && localizationCurrent(io)) io.localization_ignored = false;  // caught up
+  }
 }
 
 void StageRos::onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg)

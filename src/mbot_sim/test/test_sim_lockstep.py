@@ -8,6 +8,11 @@ boundary, so while the test drives, sim time never gets more than one period (+ 
 for a boundary between two steps) past the last boundary the test answered. Without lockstep sim time runs seconds ahead within the 20 ms.
 When the test stops sending, robot_0 is no longer waited for: sim time runs on (> 5 s sim within
 a few wall seconds), it does not hang.
+
+A slow localization for robot_1 (not driven) holds sim time the same way: it answers each boundary
+20 ms late with map -> robot_1/odom stamped at that boundary, and sim time never gets more than
+~lockstep_localization_lag + one period (+ one step) past the newest stamp. When it stops, sim time
+runs on after one wall timeout.
 """
 import math
 import sys
@@ -19,10 +24,13 @@ import rospy
 import rostest
 import yaml
 from geometry_msgs.msg import Twist
+from geometry_msgs.msg import TransformStamped
 from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
 
 ANSWER_DELAY = 0.02  # [s wall] how long the controller "computes"
 ANSWERS = 40         # boundaries answered while driving
+WARM_UP = 3          # answers before the checks start
 
 
 class ClockWatch(object):
@@ -60,12 +68,67 @@ def wait_for(condition, wall_timeout, what):
         time.sleep(0.001)
 
 
+def sim_settings():
+    """(lockstep period, physics step) of the running stage_node [s]."""
+    with open(rospy.get_param("/stage_node/world")) as f:
+        step = yaml.safe_load(f)["physics_step"]
+    return rospy.get_param("/stage_node/lockstep_period"), step
+
+
 class SimLockstep(unittest.TestCase):
-    def test_slow_controller_holds_sim_time_and_release(self):
+    @classmethod
+    def setUpClass(cls):
         rospy.init_node("test_sim_lockstep")
-        period = rospy.get_param("/stage_node/lockstep_period")
-        with open(rospy.get_param("/stage_node/world")) as f:
-            step = yaml.safe_load(f)["physics_step"]
+
+    def test_slow_localization_holds_sim_time_and_release(self):
+        period, step = sim_settings()
+        lag = rospy.get_param("/stage_node/lockstep_localization_lag")
+        limit = lag + period + step + 1e-6
+        watch = ClockWatch(limit)
+        pub = rospy.Publisher("/tf", TFMessage, queue_size=10, tcp_nodelay=True)
+        wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
+        boundary = lambda: math.floor(watch.now() / period + 1e-6) * period  # noqa: E731
+
+        def publish(stamp):
+            t = TransformStamped()
+            t.header.stamp = rospy.Time.from_sec(stamp)
+            t.header.frame_id = "map"
+            t.child_frame_id = "robot_1/odom"
+            t.transform.rotation.w = 1.0
+            pub.publish(TFMessage([t]))
+
+        # Until the first transform arrives the sim runs free: warm up (unchecked) until it holds.
+        published = None
+        for i in range(WARM_UP + ANSWERS):
+            wait_for(lambda: published is None or boundary() > published + 1e-6, 2.0, "sim time to pass a boundary")
+            b = boundary()
+            if i == WARM_UP:
+                wall_start, sim_start = time.time(), b
+            time.sleep(ANSWER_DELAY)
+            published = b
+            if i >= WARM_UP:
+                with watch.lock:
+                    watch.last_answered = b
+            publish(b)
+        sim_run = watch.now() - sim_start
+        wall_run = time.time() - wall_start
+        with watch.lock:
+            watch.last_answered = None
+            violations, worst = list(watch.violations), watch.worst_lead
+        print("localization: %.2f s sim in %.2f s wall (%d transforms); largest lead over the newest stamp %.3f s "
+              "(allowed %.3f s)" % (sim_run, wall_run, ANSWERS, worst, limit))
+        self.assertEqual(len(violations), 0, "sim time ran ahead of the localization (stamp, sim time): %s"
+                         % violations[:5])
+        # Each transform releases sim time up to the first boundary more than `lag` past its stamp.
+        self.assertLess(sim_run, ANSWERS * limit + limit)
+
+        # Stop publishing: after one wall timeout the localization is not waited for any more.
+        t0, w0 = watch.now(), time.time()
+        wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after the localization stopped")
+        print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
+
+    def test_slow_controller_holds_sim_time_and_release(self):
+        period, step = sim_settings()
         limit = period + step + 1e-6
         watch = ClockWatch(limit)
         pub = rospy.Publisher("/robot_0/cmd_vel", Twist, queue_size=10, tcp_nodelay=True)

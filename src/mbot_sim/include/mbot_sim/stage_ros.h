@@ -20,6 +20,7 @@
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <map>
@@ -54,6 +55,8 @@ struct StageParams
   double lockstep_active_timeout = 0.5;  ///< ~lockstep_active_timeout: a robot is driven while its
                                          ///< last cmd_vel is at most this old [s sim time]
   double lockstep_wall_timeout = 0.5;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
+  double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: a driven robot's localization
+                                           ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
@@ -100,6 +103,9 @@ private:
     double last_cmd_time = -1e9;  ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
     long cmd_boundary = -1;       ///< boundary_count_ when the last cmd_vel arrived
     bool cmd_unused = false;      ///< lockstep: the last cmd_vel has not released a boundary yet
+    double localization_stamp = -1e9;  ///< lockstep: newest stamp of a transform to <ns>/odom [s]
+    bool localization_ignored = false; ///< lockstep: its localization timed out; not waited for
+                                       ///< until it has caught up
   };
 
   const mbot_description::RobotModel& model(const std::string& name);
@@ -111,6 +117,8 @@ private:
   bool waitForControllers();
 
   void onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg);
+  void onTf(const tf2_msgs::TFMessage::ConstPtr& msg);
+  bool localizationCurrent(const RobotIo& io) const;
   void onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg);
   bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onPause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
@@ -131,6 +139,7 @@ private:
 
   std::vector<std::unique_ptr<RobotIo>> io_;  ///< by robot id; nullptr for removed robots
   ros::Publisher clock_pub_, contact_pub_, marker_pub_;
+  ros::Subscriber tf_sub_;  ///< lockstep only: the robots' localization transforms
   std::vector<ros::ServiceServer> services_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
