@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -292,43 +293,44 @@ namespace
 /// border of one free cell around the grid (see longSteps for why).
 struct CellMaps
 {
-  const uint8_t* quadrant_clearance[4];
+  /// Per quadrant, where cell (0, 0) is: cell (cx, cy) is at cell00[q][cy * stride + cx], for
+  /// -1 <= cx <= w, -1 <= cy <= h (the border included). Indexing from cell (0, 0) rather than
+  /// from the border's corner saves two additions per cell looked at.
+  const uint8_t* cell00[4];
+  ptrdiff_t stride;  ///< w + 2
   int w;
   int h;
-
-  /// Index of cell (cx, cy), for -1 <= cx <= w, -1 <= cy <= h (the border included).
-  size_t index(int64_t cx, int64_t cy) const
-  {
-    return static_cast<size_t>((cy + 1) * (w + 2) + cx + 1);
-  }
-  /// True for the grid and its border.
-  bool mapped(int cx, int cy) const
-  {
-    return static_cast<unsigned>(cx + 1) < static_cast<unsigned>(w + 2) &&
-           static_cast<unsigned>(cy + 1) < static_cast<unsigned>(h + 2);
-  }
 };
+
+/// The clearance map of the quadrant a direction heads into (bit 0: u_x < 0, bit 1: u_y < 0).
+inline int quadrantOf(double ux, double uy)
+{
+  return (ux < 0.0 ? 1 : 0) | (uy < 0.0 ? 2 : 0);
+}
 
 /// A ray and its per-ray constants [cells].
 struct Ray
 {
-  double px, py;             ///< origin
-  double ux, uy;             ///< unit direction
-  double inv_ux, inv_uy;     ///< 1 / u (+-Inf for a zero component: never crosses on that axis)
-  double t_end;              ///< the max range, or where the ray leaves the grid if sooner
-  const uint8_t* clearance;  ///< the clearance map of the ray's direction quadrant
+  double px, py;          ///< origin
+  double ux, uy;          ///< unit direction (never -0.0: see makeRay)
+  double inv_ux, inv_uy;  ///< 1 / u (+Inf for a zero component: never crosses on that axis)
+  double t_end;           ///< the max range, or where the ray leaves the grid if sooner
+  const uint8_t* map;     ///< cell (0, 0) of the clearance map of the ray's direction quadrant
 };
 
 /// The ray p + t u, t <= t_max. p may be outside the grid (the caller then starts the ray
 /// where it enters); t_end is cut where the ray leaves the grid.
 inline Ray makeRay(const CellMaps& m, double px, double py, double ux, double uy, double t_max)
 {
-  const int quadrant = (ux < 0.0 ? 1 : 0) | (uy < 0.0 ? 2 : 0);
-  Ray r{ px, py, ux, uy, 1.0 / ux, 1.0 / uy, t_max, m.quadrant_clearance[quadrant] };
-  if (ux != 0.0)
-    r.t_end = std::min(r.t_end, ((ux > 0.0 ? m.w : 0) - px) * r.inv_ux);
-  if (uy != 0.0)
-    r.t_end = std::min(r.t_end, ((uy > 0.0 ? m.h : 0) - py) * r.inv_uy);
+  // -0.0 + 0.0 is +0.0: a zero component then has 1 / u = +Inf, so that the cell walk, which
+  // goes by the sign of 1 / u, never crosses on that axis, and t_end below ignores that axis.
+  ux += 0.0;
+  uy += 0.0;
+  Ray r{ px, py, ux, uy, 1.0 / ux, 1.0 / uy, t_max, m.cell00[quadrantOf(ux, uy)] };
+  // Where the ray leaves the grid on each axis (+Inf for a zero component; written with
+  // selects and min, no branches: this runs for every beam).
+  r.t_end = std::min(r.t_end, (r.inv_ux > 0.0 ? m.w - px : -px) * r.inv_ux);
+  r.t_end = std::min(r.t_end, (r.inv_uy > 0.0 ? m.h - py : -py) * r.inv_uy);
   return r;
 }
 
@@ -355,155 +357,184 @@ inline int cellBehind(double v, double u)
 // moves (truncated towards zero) then never puts it in a cell ahead of the ray, and it stays
 // far closer to the ray than the clearance margin.
 constexpr int64_t kFixedBehind = int64_t{ 1 } << 12;  // 2^-20 cells
+// Beams whose long steps are interleaved, and for how many steps at most (see
+// LongSteps::runGroup). Most rays need at most 6 steps; groups of 2 to 8 and 4 to 99 steps
+// measured within noise of each other in the benchmark room.
+constexpr int kGroup = 4;
+constexpr int kLockstepSteps = 6;
 
-/// Long steps for N rays at once, each starting at its position in a cell whose clearance
-/// allows a long step. Afterwards every ray is either next to a wall (to be walked) or
-/// finished. Why N at once: each step needs the clearance of the cell the previous step landed
-/// in, so one ray is a chain of memory reads that each wait for the one before. Interleaving
-/// the steps of a few independent rays lets the processor overlap those waits; the loop
-/// exits (hard to predict) are also shared. For N = 1 this is the plain sphere-tracing loop.
-template <int N>
-void longSteps(const CellMaps& m, const Ray* rays, RayPosition* pos)
+/// Coordinate v [cells] in fixed point, moved a hair behind along direction component u.
+inline int64_t toFixedBehind(double v, double u)
 {
-  // Position in fixed point: the cell of a point is a shift, not a float-to-int conversion,
-  // on the chain every step waits for. The distance travelled is counted in whole clearance
-  // units; past `limit` the ray is beyond t_end. Until then it is inside the grid, and its
-  // fixed-point position at worst a hair outside, in the maps' border, whose free cells stop
-  // the long steps: so no bounds checks are needed here.
-  int64_t fx[N], fy[N], move_x[N], move_y[N], units[N], limit[N];
-  double t0[N];
-  for (int k = 0; k < N; ++k)
-  {
-    const Ray& r = rays[k];
-    const unsigned c = r.clearance[m.index(pos[k].cx, pos[k].cy)];
-    t0[k] = pos[k].t + c * kClearanceUnit;  // the first jump, from anywhere in the start cell
-    limit[k] = t0[k] <= r.t_end ? static_cast<int64_t>((r.t_end - t0[k]) / kClearanceUnit) : -1;
-    move_x[k] = static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne);
-    move_y[k] = static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne);
-    fx[k] = static_cast<int64_t>((r.px + t0[k] * r.ux) * kFixedOne) -
-            (r.ux > 0.0 ? kFixedBehind : r.ux < 0.0 ? -kFixedBehind : 0);
-    fy[k] = static_cast<int64_t>((r.py + t0[k] * r.uy) * kFixedOne) -
-            (r.uy > 0.0 ? kFixedBehind : r.uy < 0.0 ? -kFixedBehind : 0);
-    units[k] = 0;
-  }
-  bool moving = true;
-  while (moving)
-  {
-    moving = false;
-    for (int k = 0; k < N; ++k)
-    {
-      if (units[k] > limit[k])
-        continue;  // past t_end: finished
-      const unsigned c = rays[k].clearance[m.index(fx[k] >> kFixedShift, fy[k] >> kFixedShift)];
-      if (c < kMinLongStep)
-        continue;  // next to a wall: stays here (and is just looked at again, which is cheap)
-      fx[k] += c * move_x[k];
-      fy[k] += c * move_y[k];
-      units[k] += c;
-      moving = true;
-    }
-  }
-  for (int k = 0; k < N; ++k)
-  {
-    pos[k].finished = units[k] > limit[k];
-    pos[k].t = t0[k] + units[k] * kClearanceUnit;
-    pos[k].cx = static_cast<int>(fx[k] >> kFixedShift);
-    pos[k].cy = static_cast<int>(fy[k] >> kFixedShift);
-  }
+  return static_cast<int64_t>(v * kFixedOne) -
+         (u > 0.0 ? kFixedBehind : u < 0.0 ? -kFixedBehind : 0);
 }
 
-/// Trace one ray from its position (not in a wall; in the border at worst) to the end: the t
-/// of the first occupied cell's boundary, or t_end when there is none.
-inline double traceRay(const CellMaps& m, const Ray& r, RayPosition pos)
+/// A ray during its long steps. Position in fixed point: the cell of a point is then a shift,
+/// not a float-to-int conversion, on the chain of memory reads every step waits for. The
+/// distance travelled is counted in whole clearance units, and each step is cut to the units
+/// left (`room`: up to t_end, plus one), so a ray stops at most a quarter cell past t_end.
+/// Until t_end it is inside the grid, so it is never more than a hair outside, in the maps'
+/// border (whose free cells stop the long steps): no bounds checks are needed.
+struct LongSteps
 {
+  int64_t fx, fy;          ///< position, a hair behind the ray [cells, 32.32 fixed point]
+  int64_t move_x, move_y;  ///< one clearance unit along the ray, in fixed point
+  int64_t room;            ///< units left: 0 once the ray is past t_end
+
+  /// One long step: returns the units moved, 0 when next to a wall (clearance below
+  /// kMinLongStep) or out of room. Selects, no branches.
+  int64_t step(const uint8_t* map, ptrdiff_t stride)
+  {
+    const int64_t c = map[(fy >> kFixedShift) * stride + (fx >> kFixedShift)];
+    const int64_t units = c >= kMinLongStep ? std::min(c, room) : 0;
+    fx += units * move_x;
+    fy += units * move_y;
+    room -= units;
+    return units;
+  }
+
+  /// Long steps until next to a wall or out of room.
+  void run(const uint8_t* map, ptrdiff_t stride)
+  {
+    while (step(map, stride) != 0)
+    {
+    }
+  }
+
+  /// run() for N rays at once. Each step needs the clearance of the cell the previous step
+  /// landed in, so one ray is a chain of memory reads that each wait for the one before;
+  /// stepping a few independent rays in turn lets the processor overlap those waits. A ray
+  /// that has stopped takes steps of 0 until the others stop too, for at most kLockstepSteps
+  /// steps: the few rays that need many more (running almost along a wall) go on alone.
+  template <int N, typename RayT>
+  static void runGroup(const RayT* rays, LongSteps* s, ptrdiff_t stride)
+  {
+    for (int iteration = 0; iteration < kLockstepSteps; ++iteration)
+    {
+      int64_t moved = 0;
+      for (int k = 0; k < N; ++k)
+        moved |= s[k].step(rays[k].map, stride);
+      if (moved == 0)
+        return;
+    }
+    for (int k = 0; k < N; ++k)
+      s[k].run(rays[k].map, stride);
+  }
+};
+
+/// Long steps for ray r from pos, whose cell has a clearance of at least kMinLongStep.
+/// Afterwards the ray is either next to a wall (to be walked) or finished.
+inline void longSteps(const Ray& r, ptrdiff_t stride, RayPosition& pos)
+{
+  // The first jump, from anywhere in the cell: in floating point, since pos may lie right on
+  // the cell's boundary, where the fixed point could fall into the cell behind.
+  const unsigned c = r.map[pos.cy * stride + pos.cx];
+  const double t0 = pos.t + c * kClearanceUnit;
+  const int64_t room0 =
+      t0 <= r.t_end ? static_cast<int64_t>((r.t_end - t0) * (1.0 / kClearanceUnit)) + 1 : 0;
+  LongSteps s{ toFixedBehind(r.px + t0 * r.ux, r.ux), toFixedBehind(r.py + t0 * r.uy, r.uy),
+               static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne),
+               static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne), room0 };
+  s.run(r.map, stride);
+  pos.finished = s.room == 0;
+  pos.t = t0 + (room0 - s.room) * kClearanceUnit;
+  pos.cx = static_cast<int>(s.fx >> kFixedShift);
+  pos.cy = static_cast<int>(s.fy >> kFixedShift);
+}
+
+/// The exact cell walk of ray r from pos (not in a wall; in the border at worst). Returns true
+/// with `t_hit` = the t of the first occupied cell's boundary, or t_end when there is none
+/// before; false when the ray reached open space again first: pos is then that cell's entry,
+/// from where long steps go on.
+inline bool walkCells(const Ray& r, ptrdiff_t stride, RayPosition& pos, double& t_hit)
+{
+  // The walk moves a map index: one cell along x is +-1, along y +-stride. Directions go by the
+  // sign of 1 / u, which is +Inf for a zero component (see makeRay): never crossed.
+  const bool right = r.inv_ux > 0.0;
+  const bool up = r.inv_uy > 0.0;
   const double delta_x = std::abs(r.inv_ux);  // t between two vertical boundaries
   const double delta_y = std::abs(r.inv_uy);  // t between two horizontal boundaries
-  const int step_x = r.ux > 0.0 ? 1 : -1;
-  const int step_y = r.uy > 0.0 ? 1 : -1;
+  double t = pos.t;
+  int cx = pos.cx;
+  int cy = pos.cy;
+  // Ray parameter of the next vertical (x) and horizontal (y) cell boundary.
+  double next_x = (cx + (right ? 1 : 0) - r.px) * r.inv_ux;
+  double next_y = (cy + (up ? 1 : 0) - r.py) * r.inv_uy;
+  // Placed a cell behind (see cellBehind), the ray is already past that boundary: move the cell
+  // up without moving t (for a ray almost parallel to the boundary, the crossing lies far back
+  // along the line).
+  if (next_x < t || next_y < t)
+  {
+    if (next_x < t)
+    {
+      cx += right ? 1 : -1;
+      next_x += delta_x;
+    }
+    if (next_y < t)
+    {
+      cy += up ? 1 : -1;
+      next_y += delta_y;
+    }
+    if (r.map[cy * stride + cx] == kWallCell)
+    {
+      t_hit = t;
+      return true;
+    }
+  }
+  const ptrdiff_t index_step_x = right ? 1 : -1;
+  const ptrdiff_t index_step_y = up ? stride : -stride;
+  ptrdiff_t cell = cy * stride + cx;
   for (;;)
   {
-    // ---- 1. long steps through open space
-    if (r.clearance[m.index(pos.cx, pos.cy)] >= kMinLongStep)
+    // Cross into the next cell through whichever boundary comes first. Written as selects
+    // rather than if/else: the choice is close to random, so a branch would often be
+    // mispredicted, which costs more than computing both.
+    const bool cross_x = next_x < next_y;
+    t = cross_x ? next_x : next_y;
+    // Before t_end the ray is inside the grid, and the walk at worst one cell behind it, in
+    // the border: the cell index needs no bounds check.
+    if (t >= r.t_end)
     {
-      longSteps<1>(m, &r, &pos);
+      t_hit = r.t_end;
+      return true;
+    }
+    next_x += cross_x ? delta_x : 0.0;
+    next_y += cross_x ? 0.0 : delta_y;
+    cell += cross_x ? index_step_x : index_step_y;
+    const unsigned c = r.map[cell];
+    if (c == kWallCell)
+    {
+      t_hit = t;
+      return true;
+    }
+    if (c >= kResumeLongSteps)
+      break;  // open space again
+  }
+  // (Rare: the cell's coordinates from its index, counted from the border's corner.)
+  const ptrdiff_t from_corner = cell + stride + 1;
+  pos = RayPosition{ t, static_cast<int>(from_corner % stride) - 1,
+                     static_cast<int>(from_corner / stride) - 1, false };
+  return false;
+}
+
+/// Trace ray r from pos (not in a wall; in the border at worst) to the end: the t of the first
+/// occupied cell's boundary, or t_end when there is none.
+inline double traceRay(const Ray& r, ptrdiff_t stride, RayPosition pos)
+{
+  for (;;)
+  {
+    if (r.map[pos.cy * stride + pos.cx] >= kMinLongStep)
+    {
+      longSteps(r, stride, pos);
       if (pos.finished)
         return r.t_end;
     }
-
-    // ---- 2. exact cell walk next to walls
-    double t = pos.t;
-    int cx = pos.cx;
-    int cy = pos.cy;
-    // Ray parameter of the next vertical (x) and horizontal (y) cell boundary.
-    double next_x = r.ux > 0.0 ? (cx + 1 - r.px) * r.inv_ux
-                    : r.ux < 0.0 ? (cx - r.px) * r.inv_ux
-                                 : kInf;
-    double next_y = r.uy > 0.0 ? (cy + 1 - r.py) * r.inv_uy
-                    : r.uy < 0.0 ? (cy - r.py) * r.inv_uy
-                                 : kInf;
-    // Placed a cell behind (see cellBehind), the ray is already past that boundary: move the
-    // cell up without moving t (for a ray almost parallel to the boundary, the crossing lies
-    // far back along the line).
-    if (next_x < t || next_y < t)
-    {
-      if (next_x < t)
-      {
-        cx += step_x;
-        next_x += delta_x;
-      }
-      if (next_y < t)
-      {
-        cy += step_y;
-        next_y += delta_y;
-      }
-      if (r.clearance[m.index(cx, cy)] == kWallCell)
-        return t;
-    }
-    for (;;)
-    {
-      // Cross into the next cell through whichever boundary comes first. Written as selects
-      // rather than if/else: the choice is close to random, so a branch would often be
-      // mispredicted, which costs more than computing both.
-      const bool cross_x = next_x < next_y;
-      t = cross_x ? next_x : next_y;
-      next_x += cross_x ? delta_x : 0.0;
-      next_y += cross_x ? 0.0 : delta_y;
-      cx += cross_x ? step_x : 0;
-      cy += cross_x ? 0 : step_y;
-      // Before t_end the ray is inside the grid, and the walk at worst one cell behind it, in
-      // the border; mapped() only guards against the impossible.
-      if (t >= r.t_end || !m.mapped(cx, cy))
-        return r.t_end;
-      const unsigned c = r.clearance[m.index(cx, cy)];
-      if (c == kWallCell)
-        return t;
-      if (c >= kResumeLongSteps)
-        break;  // open space again: back to long steps from this cell's entry point
-    }
-    pos = RayPosition{ t, cx, cy, false };
+    double t_hit;
+    if (walkCells(r, stride, pos, t_hit))
+      return t_hit;
   }
 }
-
-/// Trace N rays that start together at position `start` (the sensor's cell, not a wall): long
-/// steps in lockstep, then each ray finishes on its own (the walk, and any later long steps).
-template <int N>
-void traceGroup(const CellMaps& m, const Ray* rays, RayPosition start, double* t_hit)
-{
-  RayPosition pos[N];
-  bool jump = true;  // (near a wall some rays may not: then each ray goes on its own)
-  for (int k = 0; k < N; ++k)
-  {
-    pos[k] = start;
-    jump = jump && rays[k].clearance[m.index(start.cx, start.cy)] >= kMinLongStep;
-  }
-  if (jump)
-    longSteps<N>(m, rays, pos);
-  for (int k = 0; k < N; ++k)
-    t_hit[k] = pos[k].finished ? rays[k].t_end : traceRay(m, rays[k], pos[k]);
-}
-
-// Rays traced together by castFan (see longSteps): 4 measured best in the benchmark room.
-constexpr int kGroup = 4;
 }  // namespace
 
 double GridRaycaster::cast(double x, double y, double theta, double max_range) const
@@ -532,9 +563,13 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
     if (!std::isfinite(dir_x[i]) || !std::isfinite(dir_y[i]))
       throw std::invalid_argument("GridRaycaster: ray direction " + std::to_string(i) +
                                   " is not finite");
-  const CellMaps maps{ { quadrant_clearance_[0].data(), quadrant_clearance_[1].data(),
-                         quadrant_clearance_[2].data(), quadrant_clearance_[3].data() },
-                       static_cast<int>(size_x_), static_cast<int>(size_y_) };
+  const ptrdiff_t stride = static_cast<ptrdiff_t>(size_x_) + 2;
+  CellMaps maps;
+  for (int q = 0; q < 4; ++q)
+    maps.cell00[q] = quadrant_clearance_[q].data() + stride + 1;
+  maps.stride = stride;
+  maps.w = static_cast<int>(size_x_);
+  maps.h = static_cast<int>(size_y_);
   const double px = (x - origin_x_) * inv_resolution_;  // [cells]
   const double py = (y - origin_y_) * inv_resolution_;
   const double t_max = max_range * inv_resolution_;
@@ -542,35 +577,77 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
     return selectNoBranch<double, uint64_t>(t_hit < r.t_end, t_hit * resolution_, max_range);
   };
 
-  int i = 0;
   if (px >= 0.0 && py >= 0.0 && px < maps.w && py < maps.h)
   {
-    // The usual case, a sensor inside the grid: whole groups of beams, then the rest.
-    const RayPosition start{ 0.0, static_cast<int>(px), static_cast<int>(py), false };
-    if (occupied_[static_cast<size_t>(start.cy) * size_x_ + start.cx])
+    // The usual case, a sensor inside the grid. Every beam starts in the sensor's cell, so
+    // what depends only on that cell is looked up once per scan: its clearance in each
+    // quadrant (the first long step of every beam), and the sensor in fixed point.
+    const int cx = static_cast<int>(px);
+    const int cy = static_cast<int>(py);
+    if (occupied_[static_cast<size_t>(cy) * size_x_ + cx])
     {
       std::fill(ranges, ranges + n, 0.0);  // the sensor is inside a wall
       return;
     }
-    for (; i + kGroup <= n; i += kGroup)
+    int64_t first_jump[4];
+    for (int q = 0; q < 4; ++q)
     {
-      Ray rays[kGroup];
-      double t_hit[kGroup];
-      for (int k = 0; k < kGroup; ++k)
-        rays[k] = makeRay(maps, px, py, dir_x[i + k], dir_y[i + k], t_max);
-      traceGroup<kGroup>(maps, rays, start, t_hit);
-      for (int k = 0; k < kGroup; ++k)
-        ranges[i + k] = toRange(t_hit[k], rays[k]);
+      const int64_t c = maps.cell00[q][cy * stride + cx];
+      first_jump[q] = c >= kMinLongStep ? c : 0;  // (next to a wall: none)
     }
-    for (; i < n; ++i)
+    const int64_t fx0 = static_cast<int64_t>(px * kFixedOne);  // exact: px >= 0, times 2^32
+    const int64_t fy0 = static_cast<int64_t>(py * kFixedOne);
+    // Beams go in groups of kGroup, whose long steps are interleaved (see LongSteps::run).
+    for (int i0 = 0; i0 < n; i0 += kGroup)
     {
-      const Ray r = makeRay(maps, px, py, dir_x[i], dir_y[i], t_max);
-      ranges[i] = toRange(traceRay(maps, r, start), r);
+      const int count = std::min(kGroup, n - i0);
+      Ray rays[kGroup];
+      LongSteps steps[kGroup];
+      int64_t room0[kGroup];
+      for (int k = 0; k < count; ++k)
+      {
+        const Ray& r = rays[k] = makeRay(maps, px, py, dir_x[i0 + k], dir_y[i0 + k], t_max);
+        // The first long step, from anywhere in the sensor's cell: the sensor point moved by
+        // first_jump units (cut short by t_end only), kept a hair behind the ray.
+        room0[k] = static_cast<int64_t>(r.t_end * (1.0 / kClearanceUnit)) + 1;
+        const int64_t first = std::min(first_jump[quadrantOf(r.ux, r.uy)], room0[k]);
+        LongSteps& s = steps[k];
+        s.move_x = static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne);
+        s.move_y = static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne);
+        s.fx = fx0 + first * s.move_x -
+               (r.ux > 0.0 ? kFixedBehind : r.ux < 0.0 ? -kFixedBehind : 0);
+        s.fy = fy0 + first * s.move_y -
+               (r.uy > 0.0 ? kFixedBehind : r.uy < 0.0 ? -kFixedBehind : 0);
+        s.room = room0[k] - first;
+      }
+      if (count == kGroup)
+        LongSteps::runGroup<kGroup>(rays, steps, stride);
+      else
+        for (int k = 0; k < count; ++k)
+          steps[k].run(rays[k].map, stride);
+      for (int k = 0; k < count; ++k)
+      {
+        const Ray& r = rays[k];
+        const LongSteps& s = steps[k];
+        if (s.room == 0)
+        {
+          ranges[i0 + k] = max_range;  // past t_end without meeting a wall
+          continue;
+        }
+        // Next to a wall: the exact walk (and, rarely, more long steps after it).
+        RayPosition pos{ (room0[k] - s.room) * kClearanceUnit,
+                         static_cast<int>(s.fx >> kFixedShift),
+                         static_cast<int>(s.fy >> kFixedShift), false };
+        double t_hit;
+        if (!walkCells(r, stride, pos, t_hit))
+          t_hit = traceRay(r, stride, pos);
+        ranges[i0 + k] = toRange(t_hit, r);
+      }
     }
     return;
   }
   // A sensor outside the grid (which counts as free): a ray starts where it enters the grid.
-  for (; i < n; ++i)
+  for (int i = 0; i < n; ++i)
   {
     const Ray r = makeRay(maps, px, py, dir_x[i], dir_y[i], t_max);
     // The entry: the last of the two slab entries (a zero component never leaves its slab).
@@ -594,7 +671,7 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
     const RayPosition start{ t_start,
                              std::clamp(cellBehind(px + t_start * r.ux, r.ux), -1, maps.w),
                              std::clamp(cellBehind(py + t_start * r.uy, r.uy), -1, maps.h), false };
-    ranges[i] = toRange(traceRay(maps, r, start), r);
+    ranges[i] = toRange(traceRay(r, stride, start), r);
   }
 }
 

@@ -12,6 +12,10 @@
  * process CPU time: on a machine busy with other work it shows the speed of the code itself.
  *
  *   raycast_bench [--seconds S]   S: timed work per scenario [s], default 2 (at least 1)
+ *   raycast_bench --scans N       only the room, exactly N scans (rounded up to whole frames):
+ *                                 the same work on every run, for instruction counts, e.g.
+ *     valgrind --tool=callgrind --toggle-collect='mbot_sim::castScan*' raycast_bench --scans 2000
+ *                                 (instructions per ray = the collected count / (N * 360))
  */
 #include "mbot_sim/raycast.h"
 
@@ -183,8 +187,9 @@ struct Result
 
 /// Per frame: move the robots, rebuild the shape set, cast `scans_per_frame` scans from the
 /// next poses of the pool that are not inside a robot. Times the ray casting work (rebuild +
-/// scans, not the robots' motion nor picking poses) until it adds up to `min_seconds`.
-Result run(Scenario& sc, int scans_per_frame, double min_seconds)
+/// scans, not the robots' motion nor picking poses) until it adds up to `min_seconds`, or, when
+/// `exact_scans` > 0, until that many scans are cast.
+Result run(Scenario& sc, int scans_per_frame, double min_seconds, long exact_scans = 0)
 {
   using Clock = std::chrono::steady_clock;
   ShapeSet shapes(4.0);
@@ -205,7 +210,7 @@ Result run(Scenario& sc, int scans_per_frame, double min_seconds)
   long frames = 0;
   double elapsed = 0.0;
   double cpu_seconds = 0.0;
-  while (elapsed < min_seconds)
+  while (exact_scans > 0 ? rays < exact_scans * kBeams : elapsed < min_seconds)
   {
     sc.moveRobots();
     frame_poses.clear();
@@ -259,13 +264,16 @@ Result run(Scenario& sc, int scans_per_frame, double min_seconds)
 int main(int argc, char** argv)
 {
   double seconds = 2.0;
+  long exact_scans = 0;
   for (int i = 1; i < argc; ++i)
   {
     if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
       seconds = std::max(1.0, std::atof(argv[++i]));
+    else if (std::strcmp(argv[i], "--scans") == 0 && i + 1 < argc)
+      exact_scans = std::max(1L, std::atol(argv[++i]));
     else
     {
-      std::fprintf(stderr, "usage: %s [--seconds S]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--seconds S | --scans N]\n", argv[0]);
       return 2;
     }
   }
@@ -274,6 +282,14 @@ int main(int argc, char** argv)
   Canvas room(kRoomSize, kRoomSize);
   room.room(0.0, 0.0);
   Scenario small(room, 10, 1);
+  if (exact_scans > 0)
+  {
+    const Result r = run(small, 10, 0.0, exact_scans);
+    std::printf("{\"rays\": %ld, \"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
+                "\"returns_fraction\": %.3f}\n",
+                r.scans * kBeams, r.rays_per_second, r.cpu_rays_per_second, r.returns_fraction);
+    return 0;
+  }
   run(small, 10, 0.2);  // warm up caches and the CPU clock
   const Result a = run(small, 10, seconds);
 

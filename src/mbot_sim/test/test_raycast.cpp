@@ -423,6 +423,152 @@ TEST(GridRaycaster, NearlyAxisParallelRaysAtCellBoundariesMatchBruteForce)
   EXPECT_GT(hits, 200);
 }
 
+/// Reference for a ray given by its direction (ux, uy) rather than an angle.
+double bruteForceGridCastDir(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res,
+                             double x, double y, double ux, double uy, double max_range)
+{
+  double best = max_range;
+  for (unsigned j = 0; j < h; ++j)
+    for (unsigned i = 0; i < w; ++i)
+      if (cells[static_cast<size_t>(j) * w + i])
+        best = std::min(best, raySquare(x, y, ux, uy, i * res, j * res, (i + 1) * res,
+                                        (j + 1) * res));
+  return best;
+}
+
+TEST(GridRaycaster, FanBeamGroupsMatchBruteForce)
+{
+  // castFan traces beams in groups (long steps interleaved), then the leftover beams one by
+  // one, with the sensor cell's clearances looked up once per fan. Fans of every length modulo
+  // the group size, directions with exact zero (and -0.0) components and exactly diagonal ones
+  // mixed with random ones, sensors anywhere (also right next to walls), and max ranges that
+  // end in open space, right at walls and beyond the grid (no outer walls: rays leave it).
+  const unsigned w = 70, h = 50;
+  const double res = 0.05;
+  std::mt19937 rng(17);
+  std::vector<uint8_t> cells(w * h, 0);
+  std::bernoulli_distribution sparse(0.03);
+  for (auto& c : cells)
+    c = sparse(rng) ? 1 : 0;
+  for (int k = 5; k < 40; ++k)
+    cells[static_cast<size_t>(k) * w + k + 10] = 1;  // a diagonal staircase
+  for (unsigned y = 20; y < 24; ++y)
+    for (unsigned x = 40; x < 65; ++x)
+      cells[y * w + x] = 1;  // a block
+  const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
+
+  const double d = std::sqrt(0.5);
+  const std::vector<std::pair<double, double>> special = {
+    { 1.0, 0.0 }, { 0.0, 1.0 }, { -1.0, 0.0 }, { 0.0, -1.0 }, { -0.0, 1.0 }, { 1.0, -0.0 },
+    { -1.0, -0.0 }, { -0.0, -1.0 }, { d, d }, { -d, d }, { -d, -d }, { d, -d }
+  };
+  std::uniform_real_distribution<double> ux(0.0, w * res), uy(0.0, h * res);
+  std::uniform_real_distribution<double> ua(-M_PI, M_PI), ur(0.02, 5.0);
+  std::uniform_int_distribution<int> un(1, 23);
+  int rays = 0, hits = 0, next_to_wall = 0;
+  for (int fan = 0; fan < 400; ++fan)
+  {
+    double x = ux(rng), y = uy(rng);
+    if (fan % 4 == 0)
+    {
+      // Next to a wall: move right to the first free cell with a wall on its right, then
+      // within 1e-7 cells of that wall.
+      unsigned cx = static_cast<unsigned>(x / res);
+      const unsigned cy = static_cast<unsigned>(y / res);
+      while (cx + 1 < w && !(!cells[cy * w + cx] && cells[cy * w + cx + 1]))
+        ++cx;
+      if (cx + 1 < w)
+      {
+        x = (cx + 1 - 1e-7) * res;
+        ++next_to_wall;
+      }
+    }
+    if (grid.occupiedAt(x, y))
+      continue;
+    const int n = un(rng);
+    std::vector<double> dx(n), dy(n), got(n);
+    for (int i = 0; i < n; ++i)
+    {
+      if (i % 3 == 0)
+      {
+        const auto& u = special[(fan + i) % special.size()];
+        dx[i] = u.first;
+        dy[i] = u.second;
+      }
+      else
+      {
+        const double a = ua(rng);
+        dx[i] = std::cos(a);
+        dy[i] = std::sin(a);
+      }
+    }
+    const double max_range = fan % 5 == 0 ? 10.0 : ur(rng);  // 10 m: beyond the grid
+    grid.castFan(x, y, dx.data(), dy.data(), n, max_range, got.data());
+    for (int i = 0; i < n; ++i)
+    {
+      const double expected =
+          bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
+      ASSERT_NEAR(got[i], expected, 1e-9) << "fan " << fan << " beam " << i << " of " << n
+                                          << " from (" << x << ", " << y << ") along ("
+                                          << dx[i] << ", " << dy[i] << ") max " << max_range;
+      // The single-ray call takes the other path (no group) and must agree.
+      ASSERT_NEAR(grid.castDirection(x, y, dx[i], dy[i], max_range), expected, 1e-9);
+      ++rays;
+      hits += expected < max_range ? 1 : 0;
+    }
+  }
+  EXPECT_GT(rays, 3000);
+  EXPECT_GT(next_to_wall, 50);
+  EXPECT_GT(hits, rays / 3);
+  EXPECT_LT(hits, rays - rays / 10);  // and some reach max range or leave the grid
+}
+
+TEST(GridRaycaster, FanEdgeCases)
+{
+  // A 4 x 4 m room (0.1 m cells) with one-cell walls on all sides and a wall cell at (20, 10).
+  const double res = 0.1;
+  std::vector<Cell> walls = { { 20, 10 } };
+  for (int k = 0; k < 40; ++k)
+  {
+    walls.push_back({ k, 0 });
+    walls.push_back({ k, 39 });
+    walls.push_back({ 0, k });
+    walls.push_back({ 39, k });
+  }
+  const GridRaycaster grid = makeGrid(40, 40, res, 0.0, 0.0, walls);
+  const double d = std::sqrt(0.5);
+  // Eight beams at 0, 45, ..., 315 degrees from the centre of cell (10, 10): the diagonal ones
+  // run exactly through cell corners to the corner wall cells.
+  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
+  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  double got[8];
+  grid.castFan(1.05, 1.05, dx, dy, 8, 8.0, got);
+  EXPECT_NEAR(got[0], 0.95, 1e-12);               // to the wall cell (20, 10)
+  EXPECT_NEAR(got[2], 2.85, 1e-12);               // to the top wall (y = 3.9 m)
+  EXPECT_NEAR(got[4], 0.95, 1e-12);               // to the left wall (x = 0.1 m)
+  EXPECT_NEAR(got[6], 0.95, 1e-12);
+  EXPECT_NEAR(got[1], 2.85 * std::sqrt(2.0), 1e-9);  // corner (3.9, 3.9)
+  EXPECT_NEAR(got[5], 0.95 * std::sqrt(2.0), 1e-9);  // corner (0.1, 0.1)
+  // Right next to a wall: the sensor a hair left of the wall cell (20, 10).
+  grid.castFan(2.0 - 1e-9, 1.05, dx, dy, 8, 8.0, got);
+  EXPECT_NEAR(got[0], 1e-9, 1e-12);
+  EXPECT_NEAR(got[4], 1.9 - 1e-9, 1e-9);
+  // Max range just short of, and just past, the wall at 0.95 m.
+  grid.castFan(1.05, 1.05, dx, dy, 1, 0.95 - 1e-9, got);
+  EXPECT_EQ(got[0], 0.95 - 1e-9);
+  grid.castFan(1.05, 1.05, dx, dy, 1, 0.95 + 1e-9, got);
+  EXPECT_NEAR(got[0], 0.95, 1e-12);
+  // Without the room's walls, beams leave the grid (through edges and corners): max range.
+  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, { { 20, 10 } });
+  open_grid.castFan(1.05, 1.05, dx, dy, 8, 8.0, got);
+  EXPECT_NEAR(got[0], 0.95, 1e-12);
+  for (int i = 1; i < 8; ++i)
+    EXPECT_EQ(got[i], 8.0) << "beam " << i;
+  // A sensor on the grid's edge looking out along it.
+  EXPECT_EQ(open_grid.castDirection(0.0, 1.0, -1.0, 0.0, 8.0), 8.0);
+  EXPECT_EQ(open_grid.castDirection(0.0, 1.0, 0.0, 1.0, 8.0), 8.0);
+}
+
 TEST(GridRaycaster, RejectsInconsistentInput)
 {
   EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(10, 0), 4, 4, 0.05, 0.0, 0.0),

@@ -9,7 +9,8 @@
  * How it is fast (details in raycast.cpp):
  * - the grid keeps clearance maps (how far every cell is from the walls a ray could still
  *   hit), so a ray jumps through open space in a few long steps and walks cell by cell only
- *   next to walls; the beams of a scan are traced a few at a time, interleaved;
+ *   next to walls; the sensor cell's clearances are looked up once per scan, and the long
+ *   steps of a few beams at a time are interleaved;
  * - a scan tests each nearby shape only against the few beams inside the angle the shape
  *   covers as seen from the sensor, and shapes sit in spatial buckets so far ones are never
  *   looked at.
