@@ -4,10 +4,12 @@
  */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mbot_navigation/ompl_planner.h"
 
@@ -60,6 +62,68 @@ Costmap2D wallWithGap()
   return map;
 }
 
+/**
+ * Inflate LETHAL cells as the nav node's costmaps do (config/nav_costmaps.yaml, inflation_layer.h):
+ * within kRadius INSCRIBED, out to 0.6 m 252 * exp(-5 (d - kRadius)), d between cell centres.
+ */
+void inflateLikeTheNavNode(Costmap2D& map)
+{
+  constexpr double kInflationRadius = 0.6, kScaling = 5.0;
+  const double res = map.resolution();
+  const int r = static_cast<int>(std::ceil(kInflationRadius / res));
+  // Distance [m] from every cell to the nearest LETHAL cell, spread out from the LETHAL cells.
+  std::vector<double> dist(map.sizeX() * map.sizeY(), 1e9);
+  for (int y = 0; y < static_cast<int>(map.sizeY()); ++y)
+    for (int x = 0; x < static_cast<int>(map.sizeX()); ++x)
+    {
+      if (map.cost(x, y) != cost::LETHAL) continue;
+      for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx)
+          if (map.inBounds(x + dx, y + dy))
+          {
+            double& d = dist[map.index(x + dx, y + dy)];
+            d = std::min(d, std::hypot(dx, dy) * res);
+          }
+    }
+  for (unsigned y = 0; y < map.sizeY(); ++y)
+    for (unsigned x = 0; x < map.sizeX(); ++x)
+    {
+      const double d = dist[map.index(x, y)];
+      if (d == 0.0) continue;  // LETHAL
+      if (d <= kRadius)
+        map.setCost(x, y, cost::INSCRIBED);
+      else if (d <= kInflationRadius)
+        map.setCost(x, y, static_cast<uint8_t>(std::floor(252.0 * std::exp(-kScaling * (d - kRadius)))));
+    }
+}
+
+/// 10 x 6 m at 0.05 m; a wall at x = 5 m with a 1.2 m door for y in [2.4, 3.6] (the office's
+/// doors are 1.2 m), inflated like the nav node's costmap.
+Costmap2D wallWithDoor(double resolution = 0.05)
+{
+  Costmap2D map(static_cast<unsigned>(std::lround(10.0 / resolution)),
+                static_cast<unsigned>(std::lround(6.0 / resolution)), resolution, 0.0, 0.0);
+  addWall(map, 4.9, 0.0, 5.1, 2.4);
+  addWall(map, 4.9, 3.6, 5.1, 6.0);
+  inflateLikeTheNavNode(map);
+  return map;
+}
+
+/// Distance [m] from (x, y) to the nearest LETHAL cell centre (1e9 when none within 2 m).
+double clearance(const Costmap2D& map, double x, double y)
+{
+  double best = 1e9;
+  for (unsigned my = 0; my < map.sizeY(); ++my)
+    for (unsigned mx = 0; mx < map.sizeX(); ++mx)
+    {
+      double wx, wy;
+      map.mapToWorld(mx, my, wx, wy);
+      if (map.cost(mx, my) == cost::LETHAL && std::fabs(wx - x) < 2.0 && std::fabs(wy - y) < 2.0)
+        best = std::min(best, std::hypot(wx - x, wy - y));
+    }
+  return best;
+}
+
 int costAt(const Costmap2D& map, double x, double y)
 {
   unsigned mx, my;
@@ -75,10 +139,11 @@ double pathLength(const std::vector<Pose2D>& path)
   return len;
 }
 
-/// Every pose on a free cell, every segment free at 5 mm steps, poses <= 0.05 m apart,
+/// Every pose on a free cell, every segment free at 5 mm steps, poses at most one cell apart,
 /// endpoints equal to start and goal.
 void expectValidPath(const Costmap2D& map, const PlanResult& r, const Pose2D& start, const Pose2D& goal)
 {
+  const double max_spacing = map.resolution();
   ASSERT_TRUE(r.ok) << r.error;
   ASSERT_GE(r.path.size(), 2u);
   EXPECT_DOUBLE_EQ(r.path.front().x, start.x);
@@ -87,6 +152,7 @@ void expectValidPath(const Costmap2D& map, const PlanResult& r, const Pose2D& st
   EXPECT_DOUBLE_EQ(r.path.back().x, goal.x);
   EXPECT_DOUBLE_EQ(r.path.back().y, goal.y);
   EXPECT_DOUBLE_EQ(r.path.back().theta, goal.theta);
+  double max_step = 0.0;
   for (size_t i = 0; i < r.path.size(); ++i)
   {
     const Pose2D& p = r.path[i];
@@ -94,7 +160,7 @@ void expectValidPath(const Costmap2D& map, const PlanResult& r, const Pose2D& st
     if (i == 0) continue;
     const Pose2D& q = r.path[i - 1];
     const double d = std::hypot(p.x - q.x, p.y - q.y);
-    EXPECT_LE(d, 0.05 + 1e-9) << "pose " << i;
+    max_step = std::max(max_step, d);
     const int n = static_cast<int>(std::ceil(d / 0.005));
     for (int k = 1; k < n; ++k)
     {
@@ -103,6 +169,7 @@ void expectValidPath(const Costmap2D& map, const PlanResult& r, const Pose2D& st
           << "between poses " << i - 1 << " and " << i;
     }
   }
+  EXPECT_LE(max_step, max_spacing + 1e-9) << "poses this far apart";
 }
 }  // namespace
 
@@ -134,9 +201,120 @@ TEST(OmplPlanner, FindsThePathThroughTheGapWithEveryPlanner)
   }
 }
 
+// From (1, 1) to (9, 1) the shortest way grazes the door's lower jamb (5, 2.4); the local planner
+// stalls there. The cost-aware path goes through the middle of the door instead.
+TEST(OmplPlanner, GoesThroughTheMiddleOfADoorNotAlongTheJamb)
+{
+  const Costmap2D map = wallWithDoor();
+  const Pose2D start{1.0, 1.0, 0.0}, goal{9.0, 1.0, 0.0};
+  const double shortest = 2.0 * std::hypot(4.0, 1.55);  // via (5, 2.55), just off the jamb
+  for (const std::string name : {"rrtconnect", "rrtstar", "prmstar"})
+  {
+    SCOPED_TRACE(name);
+    OmplConfig config;
+    config.planner = name;
+    config.time_limit = 0.5;
+    OmplPlanner planner(config);
+    const PlanResult r = planner.makePlan(map, start, goal);
+    expectValidPath(map, r, start, goal);
+    double max_cost = 0.0, sum_cost = 0.0, min_clearance = 1e9;
+    for (const Pose2D& p : r.path)
+    {
+      max_cost = std::max(max_cost, static_cast<double>(costAt(map, p.x, p.y)));
+      sum_cost += costAt(map, p.x, p.y);
+      if (std::fabs(p.x - 5.0) < 0.5) min_clearance = std::min(min_clearance, clearance(map, p.x, p.y));
+    }
+    // In the middle of the door the clearance is 0.6 m (cost 26); grazing the jamb it is about
+    // 0.2 m (cost above 190).
+    EXPECT_GE(min_clearance, 0.45) << "the path passes the jamb that close";
+    EXPECT_LE(max_cost, 60.0);
+    EXPECT_LE(sum_cost / r.path.size(), 15.0) << "mean cost along the path";
+    EXPECT_LT(pathLength(r.path), 1.15 * shortest) << "no large detour for it";
+  }
+}
+
+// cost_weight 0 is the old objective, the length alone: the path grazes the jamb.
+TEST(OmplPlanner, WithoutTheCostTermTheShortestPathGrazesTheJamb)
+{
+  const Costmap2D map = wallWithDoor();
+  OmplConfig config;
+  config.planner = "rrtconnect";
+  config.cost_weight = 0.0;
+  OmplPlanner planner(config);
+  const PlanResult r = planner.makePlan(map, Pose2D{1.0, 1.0, 0.0}, Pose2D{9.0, 1.0, 0.0});
+  expectValidPath(map, r, Pose2D{1.0, 1.0, 0.0}, Pose2D{9.0, 1.0, 0.0});
+  double min_clearance = 1e9;
+  for (const Pose2D& p : r.path) min_clearance = std::min(min_clearance, clearance(map, p.x, p.y));
+  EXPECT_LT(min_clearance, 0.3);
+}
+
+// Shortcuts must not undo the clearance: a straight start-goal line through a door off-centre
+// is valid but costs more than bending through the middle.
+TEST(OmplPlanner, SimplificationKeepsTheClearance)
+{
+  const Costmap2D map = wallWithDoor();
+  // Straight from (1, 2.7) to (9, 2.7) is valid (0.3 m from the lower jamb), the middle is at 3.0.
+  const Pose2D start{1.0, 2.7, 0.0}, goal{9.0, 2.7, 0.0};
+  OmplConfig config;
+  config.planner = "rrtconnect";
+  OmplPlanner planner(config);
+  const PlanResult r = planner.makePlan(map, start, goal);
+  expectValidPath(map, r, start, goal);
+  const Pose2D* in_door = &r.path.front();  // the pose closest to the wall's centre line
+  for (const Pose2D& p : r.path)
+    if (std::fabs(p.x - 5.0) < std::fabs(in_door->x - 5.0)) in_door = &p;
+  EXPECT_NEAR(in_door->x, 5.0, 0.05);
+  EXPECT_NEAR(in_door->y, 3.0, 0.15) << "crossing the door off its middle (3.0)";
+}
+
+// The path is interpolated to the costmap's resolution by default (path_resolution 0).
+TEST(OmplPlanner, PathIsDenseAtTheCostmapResolution)
+{
+  for (const double resolution : {0.025, 0.1})
+  {
+    SCOPED_TRACE(resolution);
+    const Costmap2D map = wallWithDoor(resolution);
+    OmplConfig config;
+    config.planner = "rrtconnect";
+    OmplPlanner planner(config);
+    const Pose2D start{1.0, 1.0, 0.0}, goal{9.0, 1.0, M_PI};
+    const PlanResult r = planner.makePlan(map, start, goal);
+    expectValidPath(map, r, start, goal);  // poses at most one cell apart
+    EXPECT_GT(r.path.size(), pathLength(r.path) / resolution);
+  }
+  // An explicit spacing wins.
+  OmplConfig config;
+  config.planner = "rrtconnect";
+  config.path_resolution = 0.2;
+  OmplPlanner planner(config);
+  const PlanResult r = planner.makePlan(wallWithDoor(), Pose2D{1.0, 1.0, 0.0}, Pose2D{9.0, 1.0, 0.0});
+  ASSERT_TRUE(r.ok) << r.error;
+  for (size_t i = 1; i < r.path.size(); ++i)
+    EXPECT_LE(std::hypot(r.path[i].x - r.path[i - 1].x, r.path[i].y - r.path[i - 1].y), 0.2 + 1e-9);
+}
+
+TEST(OmplPlanner, NoPathThroughAClosedDoor)
+{
+  Costmap2D map = wallWithDoor();
+  addWall(map, 4.9, 2.3, 5.1, 3.7);  // close the door
+  inflateLikeTheNavNode(map);
+  for (const std::string name : {"rrtconnect", "rrtstar", "prmstar"})
+  {
+    SCOPED_TRACE(name);
+    OmplConfig config;
+    config.planner = name;
+    config.time_limit = 0.2;
+    OmplPlanner planner(config);
+    const PlanResult r = planner.makePlan(map, Pose2D{1.0, 1.0, 0.0}, Pose2D{9.0, 1.0, 0.0});
+    EXPECT_FALSE(r.ok);
+    EXPECT_TRUE(r.path.empty());
+    EXPECT_NE(r.error.find("found no path"), std::string::npos) << r.error;
+  }
+}
+
 TEST(OmplPlanner, SameSeedSamePath)
 {
-  const Costmap2D map = wallWithGap();
+  const Costmap2D map = wallWithDoor();
   OmplConfig config;
   config.planner = "rrtconnect";  // stops at its first solution: no dependence on timing
   OmplPlanner planner(config);
@@ -191,6 +369,36 @@ TEST(OmplPlanner, RejectsAStartInAWallAndAGoalOffTheMap)
   r = planner.makePlan(map, Pose2D{1.0, 1.0, 0.0}, Pose2D{12.0, 1.0, 0.0});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error, "goal (12.00, 1.00) is outside the costmap");
+}
+
+TEST(OmplPlanner, StartOnTheGoal)
+{
+  const Costmap2D map = wallWithDoor();
+  OmplConfig config;
+  config.time_limit = 0.2;
+  OmplPlanner planner(config);
+  const PlanResult r = planner.makePlan(map, Pose2D{1.0, 1.0, 0.0}, Pose2D{1.0, 1.0, 1.0});
+  ASSERT_TRUE(r.ok) << r.error;
+  ASSERT_GE(r.path.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.path.back().x, 1.0);
+  EXPECT_DOUBLE_EQ(r.path.back().y, 1.0);
+  EXPECT_DOUBLE_EQ(r.path.back().theta, 1.0);
+}
+
+TEST(OmplPlanner, RejectsParametersOutOfRange)
+{
+  OmplConfig config;
+  config.simplify_time_limit = -1.0;
+  EXPECT_THROW(OmplPlanner{config}, std::invalid_argument);
+  config = OmplConfig{};
+  config.cost_weight = -1.0;
+  EXPECT_THROW(OmplPlanner{config}, std::invalid_argument);
+  config = OmplConfig{};
+  config.path_resolution = -0.05;
+  EXPECT_THROW(OmplPlanner{config}, std::invalid_argument);
+  config = OmplConfig{};
+  config.time_limit = 0.0;
+  EXPECT_THROW(OmplPlanner{config}, std::invalid_argument);
 }
 
 TEST(OmplPlanner, RejectsAnUnknownPlannerName)
