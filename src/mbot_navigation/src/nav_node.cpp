@@ -138,6 +138,8 @@ OmplConfig readOmplConfig(StrictParams& p)
   c.seed = static_cast<unsigned>(seed);
   c.path_resolution = p.getDouble("path_resolution", c.path_resolution);
   c.simplify = p.getBool("simplify", c.simplify);
+  c.simplify_time_limit = p.getDouble("simplify_time_limit", c.simplify_time_limit);
+  c.cost_weight = p.getDouble("cost_weight", c.cost_weight);
   return c;
 }
 
@@ -414,7 +416,8 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   server_ = std::make_unique<ActionServer>(nh_, "move_base", false);
   server_->registerGoalCallback([this]() { onGoal(); });
   server_->registerPreemptCallback([this]() { onPreempt(); });
-  cycle_timer_ = nh_.createTimer(ros::Duration(1.0 / controller_frequency), &NavNode::cycle, this);
+  control_period_ = 1.0 / controller_frequency;
+  cycle_timer_ = nh_.createTimer(ros::Duration(control_period_), &NavNode::cycle, this);
 
   ROS_INFO("%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
            "waiting for the map and the robot's pose",
@@ -453,6 +456,12 @@ double NavNode::teammateRadius(const std::string& name)
 
 bool NavNode::robotPose(Pose2D& pose, std::string& error) const
 {
+  // Under load this node's tf listener can fall behind /clock. Wait (at most one control period of
+  // sim time) for the pose of one period ago rather than steer on an older one; with stage_node's
+  // lockstep, sim time waits for this node's cmd_vel meanwhile.
+  const ros::Time wanted = ros::Time::now() - ros::Duration(control_period_);
+  if (wanted.toSec() > 0.0)
+    tf_->canTransform(global_frame_, robot_base_frame_, wanted, ros::Duration(control_period_));
   geometry_msgs::TransformStamped t;
   try
   {

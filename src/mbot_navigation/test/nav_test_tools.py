@@ -5,32 +5,19 @@ import math
 import threading
 import time
 
-import actionlib
 import rospy
 from actionlib_msgs.msg import GoalStatus
 from mbot_msgs.msg import Contact
-from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid, Odometry
 
 from mbot_navigation.grid_paths import grid_from_msg
+from mbot_navigation.move_base_client import connect_move_base, make_goal  # noqa: F401 (tests import it from here)
 
 STATE_NAMES = {v: k for k, v in GoalStatus.__dict__.items() if k.isupper() and isinstance(v, int)}
 
 
 def state_name(state):
     return STATE_NAMES.get(state, str(state))
-
-
-def make_goal(x, y, yaw=0.0, frame="map"):
-    """A MoveBaseGoal at (x, y) [m] facing `yaw` [rad] in `frame`."""
-    goal = MoveBaseGoal()
-    goal.target_pose.header.frame_id = frame
-    goal.target_pose.header.stamp = rospy.Time.now()
-    goal.target_pose.pose.position.x = x
-    goal.target_pose.pose.position.y = y
-    goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
-    goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
-    return goal
 
 
 def wait_until(condition, timeout, what):
@@ -56,14 +43,11 @@ def wait_for_wall(condition, timeout, what):
 
 def action_client(robot, timeout=60.0):
     """A connected SimpleActionClient for /<robot>/move_base (the server starts once the nav node
-    has the map and the robot's pose). Waits `timeout` wall seconds: the nodes start in wall time,
-    while the simulator may run much faster."""
-    client = actionlib.SimpleActionClient(robot + "/move_base", MoveBaseAction)
-    deadline = time.time() + timeout
-    while not client.wait_for_server(rospy.Duration(0.1)):
-        if time.time() > deadline or rospy.is_shutdown():
-            raise AssertionError("no action server /%s/move_base after %.0f s" % (robot, timeout))
-    return client
+    has the map and the robot's pose); waits `timeout` wall seconds (see connect_move_base)."""
+    try:
+        return connect_move_base(robot, wall_timeout=timeout)
+    except RuntimeError as e:
+        raise AssertionError(str(e))
 
 
 def run_goal(client, goal, timeout):

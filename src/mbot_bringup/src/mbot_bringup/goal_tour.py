@@ -3,13 +3,12 @@ other, and exit when every robot has finished its list (mark it required to end 
 
 Parameters: ~goals (dict robot -> [[x, y, yaw], ...]) or ~goals_file + ~world (a key of the file).
 """
-import math
 
-import actionlib
 import rospy
 import yaml
 from actionlib_msgs.msg import GoalStatus
-from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+
+from mbot_navigation.move_base_client import connect_move_base, make_goal
 
 
 # actionlib_msgs/GoalStatus values by name, for messages a person reads.
@@ -17,16 +16,6 @@ STATUS_NAMES = {GoalStatus.PENDING: "PENDING", GoalStatus.ACTIVE: "ACTIVE", Goal
                 GoalStatus.SUCCEEDED: "SUCCEEDED", GoalStatus.ABORTED: "ABORTED", GoalStatus.REJECTED: "REJECTED",
                 GoalStatus.PREEMPTING: "PREEMPTING", GoalStatus.RECALLING: "RECALLING",
                 GoalStatus.RECALLED: "RECALLED", GoalStatus.LOST: "LOST"}
-
-
-def make_goal(x, y, yaw, frame="map"):
-    goal = MoveBaseGoal()
-    goal.target_pose.header.frame_id = frame
-    goal.target_pose.pose.position.x = x
-    goal.target_pose.pose.position.y = y
-    goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
-    goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
-    return goal
 
 
 def load_goals(goals_file, world):
@@ -48,7 +37,7 @@ class Tour(object):
         self.goals = list(goals)
         self.next = 0
         self.results = []   # (goal, state name, status text, sim seconds taken)
-        self.client = actionlib.SimpleActionClient("/%s/move_base" % robot, MoveBaseAction)
+        self.client = None  # connected in main()
         self.sent_at = None
 
     def done(self):
@@ -84,8 +73,10 @@ def main():
         goals = load_goals(rospy.get_param("~goals_file"), rospy.get_param("~world"))
     tours = [Tour(robot, goals[robot]) for robot in sorted(goals)]
     for tour in tours:
-        if not tour.client.wait_for_server(rospy.Duration(60.0)):
-            rospy.logfatal("goal_tour: /%s/move_base is not there after 60 s of sim time", tour.robot)
+        try:
+            tour.client = connect_move_base(tour.robot, wall_timeout=60.0)
+        except RuntimeError as e:
+            rospy.logfatal("goal_tour: %s", e)
             return 1
     rate = rospy.Rate(5)
     try:

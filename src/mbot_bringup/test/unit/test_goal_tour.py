@@ -4,7 +4,8 @@ import os
 
 import pytest
 
-from mbot_bringup.goal_tour import load_goals, make_goal
+from mbot_bringup.goal_tour import load_goals
+from mbot_navigation.move_base_client import make_goal
 
 GOALS = os.path.join(os.path.dirname(__file__), "..", "..", "config", "demo_goals.yaml")
 

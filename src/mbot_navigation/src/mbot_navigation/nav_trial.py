@@ -134,14 +134,14 @@ def stop(process, log):
 
 
 def drive(args, log):
-    import actionlib
     import rospy
     from actionlib_msgs.msg import GoalStatus
     from mbot_msgs.msg import Contact
-    from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
     from nav_msgs.msg import OccupancyGrid, Odometry
 
     import rosgraph
+
+    from mbot_navigation.move_base_client import connect_move_base, make_goal
 
     # rospy decides at init_node whether to use sim time: wait until roslaunch has set /use_sim_time.
     master = rosgraph.Master("/nav_trial")
@@ -164,11 +164,11 @@ def drive(args, log):
     rospy.Subscriber("/contacts", Contact,
                      lambda m: contacts.append(m) if robot in (m.body_a, m.body_b) else None, queue_size=100)
     grid = grid_paths.grid_from_msg(rospy.wait_for_message("/map", OccupancyGrid, timeout=60.0))
-    client = actionlib.SimpleActionClient("/%s/move_base" % robot, MoveBaseAction)
+    try:
+        client = connect_move_base(robot, wall_timeout=60.0)
+    except RuntimeError as e:
+        raise RuntimeError("%s (see %s)" % (e, args.launch_log))
     deadline = time.time() + 60.0
-    while not client.wait_for_server(rospy.Duration(0.1)):
-        if time.time() > deadline:
-            raise RuntimeError("no action server /%s/move_base after 60 s (see %s)" % (robot, args.launch_log))
     while not pose and time.time() < deadline:
         time.sleep(0.05)
     if not pose:
@@ -181,13 +181,7 @@ def drive(args, log):
     outcomes = []
     sim_start, wall_start = rospy.Time.now(), time.time()
     for i, (x, y, yaw) in enumerate(goals):
-        goal = MoveBaseGoal()
-        goal.target_pose.header.frame_id = "map"
-        goal.target_pose.header.stamp = rospy.Time.now()
-        goal.target_pose.pose.position.x = x
-        goal.target_pose.pose.position.y = y
-        goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
-        goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
+        goal = make_goal(x, y, yaw)
         before = len(contacts)
         t0 = rospy.Time.now()
         client.send_goal(goal)
@@ -198,7 +192,8 @@ def drive(args, log):
         state = client.get_state()
         outcome = {"goal": [round(x, 2), round(y, 2), round(yaw, 2)], "succeeded": state == GoalStatus.SUCCEEDED,
                    "state": state, "text": client.get_goal_status_text() if finished else "timeout",
-                   "sim_seconds": round((rospy.Time.now() - t0).to_sec(), 1), "contacts": len(contacts) - before}
+                   "sim_seconds": round((rospy.Time.now() - t0).to_sec(), 1), "contacts": len(contacts) - before,
+                   "end": [round(v, 2) for v in pose]}
         outcomes.append(outcome)
         log("run %d/%d: (%.2f, %.2f, %.2f) %s in %.1f sim s, contacts %d%s" % (
             i + 1, args.runs, x, y, yaw, "ok" if outcome["succeeded"] else "FAILED", outcome["sim_seconds"],
