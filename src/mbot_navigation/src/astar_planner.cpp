@@ -30,25 +30,25 @@ std::string fmtPoint(double x, double y)
 
 void AStarPlanner::OpenList::configure(double width, double span)
 {
-  clear();  // cells left from the last search must not survive into the new ring
   inv_width_ = static_cast<float>(1.0 / width);
   size_t n = 2;
   while (static_cast<double>(n) < span / width + 3.0) n *= 2;
-  if (n != buckets_.size())
-  {
-    buckets_.clear();
-    buckets_.resize(n);
-  }
+  buckets_.clear();  // also drops cells left from the last search
+  buckets_.resize(n);
   mask_ = n - 1;
   low_ = high_ = 0;
 }
 
-void AStarPlanner::OpenList::clear()
+void AStarPlanner::OpenList::reset(float f, uint32_t index)
 {
-  // Only the occupied range holds anything; clear() keeps each bucket's capacity.
-  if (count_ > 0)
-    for (uint64_t b = low_; b <= high_; ++b) buckets_[b & mask_].clear();
-  count_ = 0;
+  // Only [low_, high_] can hold anything; clear() keeps each bucket's capacity.
+  for (uint64_t b = low_; b <= high_; ++b)
+  {
+    buckets_[b & mask_].cells.clear();
+    buckets_[b & mask_].head = 0;
+  }
+  low_ = high_ = static_cast<uint64_t>(f * inv_width_);
+  buckets_[low_ & mask_].cells.push_back(index);
 }
 
 AStarPlanner::AStarPlanner(const AStarConfig& config) : config_(config)
@@ -75,7 +75,6 @@ void AStarPlanner::prepare(const Costmap2D& costmap)
   size_y_ = costmap.sizeY();
   const size_t n = static_cast<size_t>(size_x_) * size_y_;
   nodes_.assign(n, Node{0, 0.0f});
-  parent_dir_.assign(n, 0);
   generation_ = 0;
   for (int k = 0; k < 8; ++k) offset_[k] = kDy[k] * static_cast<int>(size_x_) + kDx[k];
   // Span of f in the open list: one step (the dearest diagonal step plus the heuristic's change)
@@ -198,42 +197,40 @@ PlanResult AStarPlanner::makePlan(const Costmap2D& costmap, const Pose2D& start,
 
 bool AStarPlanner::search(const uint8_t* costs, uint32_t start, uint32_t goal)
 {
-  // New generation; on wrap-around (after ~2^31 queries) clear the stamps once.
-  if (generation_ >= (std::numeric_limits<uint32_t>::max() >> 1) - 1)
+  // New generation; on wrap-around (after ~2^29 queries) clear the stamps once.
+  if (generation_ >= (std::numeric_limits<uint32_t>::max() >> 3) - 1)
   {
     for (Node& n : nodes_) n.stamp = 0;
     generation_ = 0;
   }
   ++generation_;
-  const uint32_t open_stamp = 2 * generation_;
-  const uint32_t closed_stamp = open_stamp + 1;
+  const uint32_t seen = generation_ << 3;  // stamp >= seen: the cell's g is from this query
 
   const int W = static_cast<int>(size_x_), H = static_cast<int>(size_y_);
   const double inv_size_x = 1.0 / size_x_;
   const int gx = static_cast<int>(goal % size_x_), gy = static_cast<int>(goal / size_x_);
-  const float h_scale = static_cast<float>(config_.neutral_cost * config_.heuristic_weight);
-  const float diag_extra = static_cast<float>(kSqrt2 - 1.0);
-  // Octile distance to the goal, in units of neutral_cost.
+  const float h_straight = static_cast<float>(config_.neutral_cost * config_.heuristic_weight);
+  const float h_diag = static_cast<float>(config_.neutral_cost * config_.heuristic_weight * (kSqrt2 - 1.0));
+  // Octile distance to the goal times neutral_cost (times the weight).
   auto heuristic = [&](int x, int y) {
     const int dx = std::abs(x - gx), dy = std::abs(y - gy);
-    return h_scale * (static_cast<float>(std::max(dx, dy)) + diag_extra * static_cast<float>(std::min(dx, dy)));
+    return h_straight * static_cast<float>(std::max(dx, dy)) + h_diag * static_cast<float>(std::min(dx, dy));
   };
 
-  nodes_[start] = Node{open_stamp, 0.0f};
-  const float start_f = heuristic(static_cast<int>(start % size_x_), static_cast<int>(start / size_x_));
-  open_.clear();
-  open_.push(start_f, start);
+  Node* const nodes = nodes_.data();
+  nodes[start] = Node{seen, 0.0f};
+  open_.reset(heuristic(static_cast<int>(start % size_x_), static_cast<int>(start / size_x_)), start);
 
-  Node* nodes = nodes_.data();
-  uint8_t* parent = parent_dir_.data();
+  const float diag = static_cast<float>(kSqrt2);
   size_t expanded = 0;
   bool found = false;
-  while (!open_.empty())
+  uint32_t idx;
+  while (open_.pop(idx))
   {
-    const uint32_t idx = open_.pop();
     Node& cur = nodes[idx];
-    if (cur.stamp == closed_stamp) continue;  // an outdated duplicate (lazy decrease-key)
-    cur.stamp = closed_stamp;
+    if (std::signbit(cur.g)) continue;  // closed: an outdated duplicate (lazy decrease-key)
+    const float g = cur.g;
+    cur.g = -g;  // close it (see Node)
     ++expanded;
     if (idx == goal)
     {
@@ -249,25 +246,24 @@ bool AStarPlanner::search(const uint8_t* costs, uint32_t start, uint32_t goal)
       x -= W;
       ++y;
     }
-    const float g = cur.g;
 
-    // Relax neighbour n (at x + dx, y + dy), entered by a step of cost `step_cost`, reached by
-    // neighbour step k: keep the better g, and queue it.
-    auto relax = [&](uint32_t n, float step_cost, int dx, int dy, uint8_t k) {
+    // Relax neighbour n (at x + dx, y + dy) entered by neighbour step k of cost `step_cost`: keep
+    // the better g and queue the cell. A closed cell has g < 0, so ng >= g rejects it too.
+    auto relax = [&](uint32_t n, float step_cost, int dx, int dy, uint32_t k) {
       Node& nb = nodes[n];
-      if (nb.stamp == closed_stamp) return;
       const float ng = g + step_cost;
-      if (nb.stamp == open_stamp && ng >= nb.g) return;
-      nb.stamp = open_stamp;
+      if (nb.stamp >= seen && ng >= nb.g) return;
+      nb.stamp = seen | k;
       nb.g = ng;
-      parent[n] = k;
       open_.push(ng + heuristic(x + dx, y + dy), n);
     };
 
     // Weights of the 8 neighbours (order of kDx/kDy). Only the outer ring of cells needs bounds
-    // checks: the neighbours of an interior cell are always inside.
+    // checks: the neighbours of an interior cell are always inside. (Unsigned: x - 1 < W - 2
+    // is 0 < x < W - 1 in one test.)
     float w[8];
-    if (x > 0 && y > 0 && x < W - 1 && y < H - 1)
+    if (static_cast<unsigned>(x - 1) < static_cast<unsigned>(W - 2) &&
+        static_cast<unsigned>(y - 1) < static_cast<unsigned>(H - 2))
     {
       for (int k = 0; k < 8; ++k) w[k] = weight_[costs[idx + offset_[k]]];
     }
@@ -279,31 +275,31 @@ bool AStarPlanner::search(const uint8_t* costs, uint32_t start, uint32_t goal)
         w[k] = (nx < 0 || ny < 0 || nx >= W || ny >= H) ? kInf : weight_[costs[idx + offset_[k]]];
       }
     }
-    const bool east = w[0] != kInf, west = w[1] != kInf, north = w[2] != kInf, south = w[3] != kInf;
-    const float diag = static_cast<float>(kSqrt2);
+    // (w < kInf rather than w != kInf: one branch, no NaN check.)
+    const bool east = w[0] < kInf, west = w[1] < kInf, north = w[2] < kInf, south = w[3] < kInf;
     if (east) relax(idx + offset_[0], w[0], 1, 0, 0);
     if (west) relax(idx + offset_[1], w[1], -1, 0, 1);
     if (north) relax(idx + offset_[2], w[2], 0, 1, 2);
     if (south) relax(idx + offset_[3], w[3], 0, -1, 3);
     // No corner cutting: a diagonal step needs both cells beside it passable, so that the segment
     // (which touches them at the corner) stays on passable cells.
-    if (east && north && w[4] != kInf) relax(idx + offset_[4], w[4] * diag, 1, 1, 4);
-    if (west && north && w[5] != kInf) relax(idx + offset_[5], w[5] * diag, -1, 1, 5);
-    if (east && south && w[6] != kInf) relax(idx + offset_[6], w[6] * diag, 1, -1, 6);
-    if (west && south && w[7] != kInf) relax(idx + offset_[7], w[7] * diag, -1, -1, 7);
+    if (east && north && w[4] < kInf) relax(idx + offset_[4], w[4] * diag, 1, 1, 4);
+    if (west && north && w[5] < kInf) relax(idx + offset_[5], w[5] * diag, -1, 1, 5);
+    if (east && south && w[6] < kInf) relax(idx + offset_[6], w[6] * diag, 1, -1, 6);
+    if (west && south && w[7] < kInf) relax(idx + offset_[7], w[7] * diag, -1, -1, 7);
   }
   stats_.expanded = expanded;
   if (!found) return false;
 
   // Walk the parents back from the goal.
-  for (uint32_t c = goal;; c -= offset_[parent[c]])
+  for (uint32_t c = goal;; c -= offset_[nodes[c].stamp & 7u])
   {
     grid_path_.push_back(c);
     if (c == start) break;
   }
   std::reverse(grid_path_.begin(), grid_path_.end());
   stats_.grid_path_cells = grid_path_.size();
-  stats_.grid_path_cost = nodes[goal].g;
+  stats_.grid_path_cost = costTo(goal);
   stats_.grid_path_length = polylineLength(grid_path_);
   return true;
 }
@@ -471,7 +467,7 @@ void AStarPlanner::smooth(const uint8_t* costs)
 {
   dense_.assign(grid_path_.begin(), grid_path_.end());
   cum_.resize(grid_path_.size());
-  for (size_t i = 0; i < grid_path_.size(); ++i) cum_[i] = nodes_[grid_path_[i]].g;
+  for (size_t i = 0; i < grid_path_.size(); ++i) cum_[i] = costTo(grid_path_[i]);
   vertices_ = grid_path_;
   double best = stats_.grid_path_length;
   // Each pass pulls the string tighter: the next pass may pick cells along the previous pass's

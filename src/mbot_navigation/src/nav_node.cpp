@@ -456,12 +456,16 @@ double NavNode::teammateRadius(const std::string& name)
 
 bool NavNode::robotPose(Pose2D& pose, std::string& error) const
 {
-  // Under load this node's tf listener can fall behind /clock. Wait (at most one control period of
-  // sim time) for the pose of one period ago rather than steer on an older one; with stage_node's
-  // lockstep, sim time waits for this node's cmd_vel meanwhile.
-  const ros::Time wanted = ros::Time::now() - ros::Duration(control_period_);
-  if (wanted.toSec() > 0.0)
-    tf_->canTransform(global_frame_, robot_base_frame_, wanted, ros::Duration(control_period_));
+  // Under load this node's tf listener can fall behind /clock. Wait a little for the pose of one
+  // control period ago rather than steer on an older one: at most one period of sim time, and at
+  // most 0.1 s wall, because with stage_node's lockstep sim time stands still until this node sends
+  // cmd_vel. (tf2's canTransform(timeout) would sleep in sim time, i.e. until the lockstep gives up.)
+  const ros::Time start = ros::Time::now();
+  const ros::Time wanted = start - ros::Duration(control_period_);
+  const ros::WallTime wall_deadline = ros::WallTime::now() + ros::WallDuration(0.1);
+  while (wanted.toSec() > 0.0 && !tf_->canTransform(global_frame_, robot_base_frame_, wanted) &&
+         (ros::Time::now() - start).toSec() < control_period_ && ros::WallTime::now() < wall_deadline && ros::ok())
+    ros::WallDuration(0.0005).sleep();
   geometry_msgs::TransformStamped t;
   try
   {

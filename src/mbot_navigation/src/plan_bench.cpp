@@ -6,6 +6,7 @@
  *   plan_bench --map map_1000.pgm --pairs pairs_1000.csv [--planner astar] [--json]
  *              [--cost-factor X] [--neutral-cost X] [--heuristic-weight X]
  *              [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]
+ *              [--per-pair] [--only I,J,...]
  *
  * The map is a raw cost PGM (P5, first row y = 0, no flip) read into a Costmap2D at 0.05 m/cell.
  * Every pair is planned once after one warm-up plan; planning only, one thread, steady_clock.
@@ -20,6 +21,8 @@
  * (p50/p95 are wall time). The A* flags override AStarConfig's defaults, for tuning.
  * --verify-inflation re-inflates the map's lethal cells with InflationLayer (inscribed 0.15 m,
  * inflation 0.55 m, factor 10, the inputs' README) and fails unless every cell matches.
+ * --per-pair prints one line per pair (time, cells expanded, path length) to find the slow tail;
+ * --only plans just the listed pair indices (0-based), e.g. to profile them under callgrind.
  * Exit status 0 only when every pair was planned and every path is valid.
  */
 #include <algorithm>
@@ -149,7 +152,8 @@ size_t verifyInflation(const Costmap2D& map)
   std::cerr << "plan_bench: " << why
             << "\nusage: plan_bench --map FILE.pgm --pairs FILE.csv [--planner astar] [--json]\n"
                "       [--cost-factor X] [--neutral-cost X] [--heuristic-weight X]\n"
-               "       [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]\n";
+               "       [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]\n"
+               "       [--per-pair] [--only I,J,...]\n";
   std::exit(2);
 }
 }  // namespace
@@ -157,7 +161,8 @@ size_t verifyInflation(const Costmap2D& map)
 int main(int argc, char** argv)
 {
   std::string map_path, pairs_path, planner_name = "astar";
-  bool json = false, verify = false;
+  bool json = false, verify = false, per_pair = false;
+  std::vector<size_t> only;
   GlobalPlannerParams params;
   for (int i = 1; i < argc; ++i)
   {
@@ -182,6 +187,15 @@ int main(int argc, char** argv)
     else if (a == "--planner") planner_name = value();
     else if (a == "--json") json = true;
     else if (a == "--verify-inflation") verify = true;
+    else if (a == "--per-pair") per_pair = true;
+    else if (a == "--only")
+    {
+      std::string list = value();
+      std::replace(list.begin(), list.end(), ',', ' ');
+      std::istringstream s(list);
+      for (size_t k; s >> k;) only.push_back(k);
+      if (only.empty()) usage("--only expects pair indices, e.g. 3,17");
+    }
     else if (a == "--cost-factor") params.astar.cost_factor = number();
     else if (a == "--neutral-cost") params.astar.neutral_cost = number();
     else if (a == "--heuristic-weight") params.astar.heuristic_weight = number();
@@ -195,7 +209,17 @@ int main(int argc, char** argv)
   try
   {
     const Costmap2D map = readCostPgm(map_path);
-    const std::vector<Pair> pairs = readPairs(pairs_path);
+    std::vector<Pair> pairs = readPairs(pairs_path);
+    if (!only.empty())
+    {
+      std::vector<Pair> picked;
+      for (size_t k : only)
+      {
+        if (k >= pairs.size()) usage("--only: no pair " + std::to_string(k));
+        picked.push_back(pairs[k]);
+      }
+      pairs.swap(picked);
+    }
     if (pairs.empty()) throw std::runtime_error(pairs_path + ": no pairs");
     if (verify && verifyInflation(map) != 0) return 1;
     std::unique_ptr<GlobalPlanner> planner = makeGlobalPlanner(planner_name, params);
@@ -242,6 +266,10 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "pair %zu: the path leaves the passable cells or misses an end\n", k);
       }
       lengths.push_back(len / kResolution);
+      if (per_pair)
+        std::printf("pair %3zu: %8.3f ms, cpu %8.3f ms, expanded %7.0f, path %7.1f cells\n",
+                    only.empty() ? k : only[k], ms.back(), cpu_ms.back(), expanded.empty() ? 0.0 : expanded.back(),
+                    len / kResolution);
     }
     double mean_len = 0.0;
     for (double l : lengths) mean_len += l;
