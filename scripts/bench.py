@@ -3,7 +3,7 @@
     scripts/bench sim [--json FILE]   simulator real-time factor for N robots, ray casting rate
     scripts/bench nav [--json FILE]   global plan time and length, DWA cycle time, and the
                                       seeded random-goal navigation trial in `office`
-        --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 5)
+        --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 0: as fast as possible)
     scripts/bench all [--json FILE]
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
@@ -74,8 +74,9 @@ def nav_trial(runs, rtf):
     """Seeded random-goal trial: one robot in `office`, each run one goal with a timeout.
 
     It runs the whole ROS stack (simulator, map server, localization, nav node), so it cannot be
-    pinned to one core. At real_time_factor 0 the simulator outruns the 20 Hz controller (there is
-    no lockstep yet), so the trial runs at a fixed factor the stack can follow on 2 cores.
+    pinned to one core. nav_trial turns on the simulator's lockstep: at real_time_factor 0 (the
+    default, the issue's condition) sim time runs as fast as the nav node and the localization can
+    follow, never ahead of them.
     """
     script = os.path.join(ROOT, "src", "mbot_navigation", "scripts", "nav_trial")
     print("$ nav_trial --runs %d --seed 1 --real-time-factor %g --json" % (runs, rtf), file=sys.stderr)
@@ -87,7 +88,7 @@ def nav_trial(runs, rtf):
     return result
 
 
-def bench_nav(trial_runs=100, trial_rtf=5.0):
+def bench_nav(trial_runs=100, trial_rtf=0.0):
     plan = {}
     for n in ("1000", "2000"):
         r = run_json([program("mbot_navigation", "plan_bench"),
@@ -127,7 +128,8 @@ def main(argv=None):
     parser.add_argument("what", choices=["sim", "nav", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
-    parser.add_argument("--trial-rtf", type=float, default=5.0, help="real-time factor of the trial")
+    parser.add_argument("--trial-rtf", type=float, default=0.0,
+                        help="real-time factor of the trial (default 0: as fast as possible, lockstep)")
     args = parser.parse_args(argv)
     result = {}
     if args.what in ("sim", "all"):
