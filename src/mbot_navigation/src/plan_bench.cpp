@@ -6,10 +6,12 @@
  *   plan_bench --map map_1000.pgm --pairs pairs_1000.csv [--planner astar] [--json]
  *              [--cost-factor X] [--neutral-cost X] [--heuristic-weight X]
  *              [--smoothing-tolerance X] [--smoothing-passes N] [--no-smooth] [--verify-inflation]
- *              [--per-pair] [--only I,J,...]
+ *              [--per-pair] [--only I,J,...] [--repeat N]
  *
  * The map is a raw cost PGM (P5, first row y = 0, no flip) read into a Costmap2D at 0.05 m/cell.
- * Every pair is planned once after one warm-up plan; planning only, one thread, steady_clock.
+ * Every pair is planned --repeat times (default 5) after one warm-up plan, and its time is the
+ * fastest of them: other processes on a busy machine only ever add time, so the minimum is the
+ * best estimate of what the planner itself needs. Planning only, one thread, steady_clock.
  * Each returned path is checked afterwards (not timed): it must start and end at the pair's cells
  * and every pose must lie on a passable cell (cost < 253). The path length is the sum of the
  * Euclidean segment lengths of the returned poses, in cells.
@@ -162,6 +164,7 @@ int main(int argc, char** argv)
 {
   std::string map_path, pairs_path, planner_name = "astar";
   bool json = false, verify = false, per_pair = false;
+  int repeat = 5;  // plans per pair; the fastest counts
   std::vector<size_t> only;
   GlobalPlannerParams params;
   for (int i = 1; i < argc; ++i)
@@ -188,6 +191,11 @@ int main(int argc, char** argv)
     else if (a == "--json") json = true;
     else if (a == "--verify-inflation") verify = true;
     else if (a == "--per-pair") per_pair = true;
+    else if (a == "--repeat")
+    {
+      repeat = static_cast<int>(number());
+      if (repeat < 1) usage("--repeat expects a number >= 1");
+    }
     else if (a == "--only")
     {
       std::string list = value();
@@ -237,12 +245,19 @@ int main(int argc, char** argv)
     {
       const Pair& p = pairs[k];
       const Pose2D s = pose(p.sx, p.sy), g = pose(p.gx, p.gy);
-      const double c0 = threadCpuMs();
-      const auto t0 = std::chrono::steady_clock::now();
-      const PlanResult r = planner->makePlan(map, s, g);
-      const auto t1 = std::chrono::steady_clock::now();
-      cpu_ms.push_back(threadCpuMs() - c0);
-      ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      PlanResult r;
+      double best_ms = 1e300, best_cpu_ms = 1e300;
+      for (int rep = 0; rep < repeat; ++rep)
+      {
+        const double c0 = threadCpuMs();
+        const auto t0 = std::chrono::steady_clock::now();
+        r = planner->makePlan(map, s, g);
+        const auto t1 = std::chrono::steady_clock::now();
+        best_cpu_ms = std::min(best_cpu_ms, threadCpuMs() - c0);
+        best_ms = std::min(best_ms, std::chrono::duration<double, std::milli>(t1 - t0).count());
+      }
+      cpu_ms.push_back(best_cpu_ms);
+      ms.push_back(best_ms);
       if (const auto* astar = dynamic_cast<const AStarPlanner*>(planner.get()))
         expanded.push_back(static_cast<double>(astar->lastStats().expanded));
       if (!r.ok)

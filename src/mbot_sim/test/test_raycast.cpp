@@ -965,3 +965,317 @@ TEST(CastScan, RejectsBadSpec)
   EXPECT_THROW(shapes.addBox(b), std::invalid_argument);
   EXPECT_EQ(shapes.size(), 0u);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Wall sweep (castScanWalls): whole scans against the wall faces, compared with the grid walk
+// and the brute-force reference
+// ---------------------------------------------------------------------------------------------
+namespace
+{
+using mbot_sim::WallMethod;
+
+/// A laser layout: n beams from first_angle, increment apart [rad].
+struct Layout
+{
+  int n;
+  double first_angle;
+  double increment;
+};
+
+/// Cells of a map with random rectangular blocks (walls, furniture) and a few single cells.
+std::vector<uint8_t> blockMap(unsigned w, unsigned h, std::mt19937& rng)
+{
+  std::vector<uint8_t> cells(static_cast<size_t>(w) * h, 0);
+  std::uniform_int_distribution<unsigned> ux(0, w - 1), uy(0, h - 1), usize(1, 12);
+  for (int k = 0; k < 25; ++k)
+  {
+    const unsigned x0 = ux(rng), y0 = uy(rng);
+    const unsigned x1 = std::min(w, x0 + usize(rng)), y1 = std::min(h, y0 + usize(rng));
+    for (unsigned y = y0; y < y1; ++y)
+      for (unsigned x = x0; x < x1; ++x)
+        cells[y * w + x] = 1;
+  }
+  return cells;
+}
+
+/// A cave: random noise smoothed by a few rounds of "occupied when most neighbours are".
+std::vector<uint8_t> caveMap(unsigned w, unsigned h, std::mt19937& rng)
+{
+  std::vector<uint8_t> cells(static_cast<size_t>(w) * h, 0);
+  std::bernoulli_distribution fill(0.42);
+  for (auto& c : cells)
+    c = fill(rng) ? 1 : 0;
+  for (int round = 0; round < 3; ++round)
+  {
+    std::vector<uint8_t> next(cells.size());
+    for (unsigned y = 0; y < h; ++y)
+      for (unsigned x = 0; x < w; ++x)
+      {
+        int around = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+          {
+            const int nx = static_cast<int>(x) + dx, ny = static_cast<int>(y) + dy;
+            around += nx < 0 || ny < 0 || nx >= static_cast<int>(w) || ny >= static_cast<int>(h)
+                          ? 1
+                          : cells[ny * w + nx];
+          }
+        next[y * w + x] = around >= 5 ? 1 : 0;
+      }
+    cells.swap(next);
+  }
+  return cells;
+}
+
+/// Cast one scan with the given method; directions are cos/sin of the beam angles.
+std::vector<double> castWalls(const GridRaycaster& grid, double x, double y, const Layout& l,
+                              double max_range, WallMethod method, std::vector<double>* dx_out = nullptr,
+                              std::vector<double>* dy_out = nullptr)
+{
+  std::vector<double> dx(l.n), dy(l.n), ranges(l.n, -1.0);
+  for (int i = 0; i < l.n; ++i)
+  {
+    dx[i] = std::cos(l.first_angle + i * l.increment);
+    dy[i] = std::sin(l.first_angle + i * l.increment);
+  }
+  grid.castScanWalls(x, y, dx.data(), dy.data(), l.first_angle, l.increment, l.n, max_range,
+                     ranges.data(), method);
+  if (dx_out)
+    *dx_out = dx;
+  if (dy_out)
+    *dy_out = dy;
+  return ranges;
+}
+
+/// Random scans in random maps of one kind: the sweep must equal the brute-force reference
+/// within 1e-9 m, and every method must agree with the grid walk within 1e-9 m.
+template <typename MakeMap>
+void checkRandomScans(MakeMap make_map, unsigned seed, int* swept_beams)
+{
+  const unsigned w = 64, h = 48;
+  const double res = 0.05;
+  std::mt19937 rng(seed);
+  const std::vector<Layout> layouts = {
+    { 360, -M_PI, 2 * M_PI / 360 },              // the usual full turn
+    { 720, -0.75 * M_PI, 1.5 * M_PI / 720 },     // 270 degrees
+    { 1, 0.3, 0.0 },                             // one beam
+    { 97, 1.0, -0.6 / 96 },                      // a narrow fan turning clockwise
+    { 500, 2.0, 2.5 * M_PI / 499 },              // more than a full turn
+  };
+  std::uniform_real_distribution<double> ux(0.0, w * res), uy(0.0, h * res);
+  std::uniform_real_distribution<double> ua(-M_PI, M_PI), ur(0.1, 4.0);
+  for (int map = 0; map < 4; ++map)
+  {
+    const std::vector<uint8_t> cells = make_map(w, h, rng);
+    const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
+    for (int scan = 0; scan < 10; ++scan)
+    {
+      double x = ux(rng), y = uy(rng);
+      if (grid.occupiedAt(x, y))
+        continue;
+      Layout l = layouts[scan % layouts.size()];
+      l.first_angle += ua(rng);  // the sensor's yaw
+      const double max_range = scan % 3 == 0 ? 10.0 : ur(rng);  // 10 m: leaves the grid
+      std::vector<double> dx, dy;
+      const std::vector<double> sweep =
+          castWalls(grid, x, y, l, max_range, WallMethod::kSweep, &dx, &dy);
+      const std::vector<double> walk = castWalls(grid, x, y, l, max_range, WallMethod::kGridWalk);
+      const std::vector<double> automatic = castWalls(grid, x, y, l, max_range, WallMethod::kAuto);
+      for (int i = 0; i < l.n; ++i)
+      {
+        const double expected =
+            bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
+        ASSERT_NEAR(sweep[i], expected, 1e-9) << "map " << map << " scan " << scan << " beam "
+                                              << i << " from (" << x << ", " << y << ")";
+        ASSERT_NEAR(sweep[i], walk[i], 1e-9) << "map " << map << " scan " << scan << " beam " << i;
+        ASSERT_NEAR(automatic[i], walk[i], 1e-9) << "map " << map << " scan " << scan;
+      }
+      *swept_beams += l.n;
+    }
+  }
+}
+}  // namespace
+
+TEST(WallSweep, FacesAreMergedRunsOfCellEdges)
+{
+  // One 3 x 2 block in the open: 4 faces (one per side), however many cell edges.
+  std::vector<Cell> block;
+  for (int y = 5; y < 7; ++y)
+    for (int x = 4; x < 7; ++x)
+      block.push_back({ x, y });
+  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, block).wallFaceCount(), 4u);
+  // A wall along the grid's edge: no face on the edge itself (outside is free, and a sensor
+  // inside never sees it), one face towards the inside.
+  std::vector<Cell> edge;
+  for (int x = 0; x < 12; ++x)
+    edge.push_back({ x, 0 });
+  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, edge).wallFaceCount(), 1u);
+  // A staircase: every step has its own faces.
+  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, { { 3, 3 }, { 4, 4 } }).wallFaceCount(), 8u);
+  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, {}).wallFaceCount(), 0u);
+}
+
+TEST(WallSweep, RandomBlockMapsMatchBruteForceAndTheWalk)
+{
+  int swept = 0;
+  checkRandomScans(blockMap, 101, &swept);
+  EXPECT_GT(swept, 5000);
+}
+
+TEST(WallSweep, RandomCaveMapsMatchBruteForceAndTheWalk)
+{
+  int swept = 0;
+  checkRandomScans(caveMap, 202, &swept);
+  EXPECT_GT(swept, 5000);
+}
+
+TEST(WallSweep, EdgeCasesMatchTheWalk)
+{
+  // The room of FanEdgeCases: 4 x 4 m, 0.1 m cells, one-cell walls all round, a wall cell at
+  // (20, 10); and the same without the room's walls, where beams leave the grid.
+  const double res = 0.1;
+  std::vector<Cell> walls = { { 20, 10 }, { 25, 25 }, { 26, 24 } };
+  for (int k = 0; k < 40; ++k)
+  {
+    walls.push_back({ k, 0 });
+    walls.push_back({ k, 39 });
+    walls.push_back({ 0, k });
+    walls.push_back({ 39, k });
+  }
+  const GridRaycaster room = makeGrid(40, 40, res, 0.0, 0.0, walls);
+  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, { { 20, 10 }, { 25, 25 } });
+  const double d = std::sqrt(0.5);
+  // Eight beams, 45 degrees apart, with exact zero components and exact diagonals.
+  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
+  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  struct Case
+  {
+    double x, y, max_range;
+    const char* what;
+  };
+  const std::vector<Case> cases = {
+    { 1.05, 1.05, 8.0, "cell centre: diagonals through cell corners" },
+    { 2.05, 2.05, 8.0, "diagonal passing the corner between (25, 25) and (26, 24)" },
+    { 2.0 - 1e-9, 1.05, 8.0, "1e-9 m left of the wall cell (20, 10)" },
+    { 2.1 + 1e-9, 1.05, 8.0, "1e-9 m right of it" },
+    { 2.05, 1.0 - 1e-9, 8.0, "1e-9 m below it" },
+    { 1.05, 1.05, 0.95, "max range exactly at a wall" },
+    { 1.05, 1.05, 0.95 - 1e-9, "max range just short of a wall" },
+    { 1.05, 1.05, 0.95 + 1e-9, "max range just past a wall" },
+    { 1.05, 1.0, 8.0, "on a grid line: beams along it graze the walls (walk used)" },
+    { 0.1 + 1e-12, 0.1 + 1e-12, 8.0, "a hair off the room's inner corner" },
+    { 2.0, 1.05, 8.0, "on the wall's face (walk used)" },
+    { 2.05, 1.05, 8.0, "inside a wall" },
+    { -1.0, 1.05, 8.0, "outside the grid (walk used)" },
+  };
+  double got[8], want[8];
+  for (const GridRaycaster* grid : { &room, &open_grid })
+    for (const Case& c : cases)
+      for (double first : { 0.0, M_PI })  // the same beams listed from another start
+      {
+        const int shift = first == 0.0 ? 0 : 4;
+        double sx[8], sy[8];
+        for (int i = 0; i < 8; ++i)
+        {
+          sx[i] = dx[(i + shift) % 8];
+          sy[i] = dy[(i + shift) % 8];
+        }
+        grid->castScanWalls(c.x, c.y, sx, sy, first, M_PI / 4, 8, c.max_range, got,
+                            WallMethod::kSweep);
+        grid->castFan(c.x, c.y, sx, sy, 8, c.max_range, want);
+        for (int i = 0; i < 8; ++i)
+          ASSERT_NEAR(got[i], want[i], 1e-12) << c.what << ", beam " << i << ", open "
+                                              << (grid == &open_grid);
+      }
+  // The analytic values in the room (as in FanEdgeCases).
+  room.castScanWalls(1.05, 1.05, dx, dy, 0.0, M_PI / 4, 8, 8.0, got, WallMethod::kSweep);
+  EXPECT_NEAR(got[0], 0.95, 1e-12);
+  EXPECT_NEAR(got[1], 1.45 * std::sqrt(2.0), 1e-9);  // corner of (25, 25) at (2.5, 2.5)
+  EXPECT_NEAR(got[5], 0.95 * std::sqrt(2.0), 1e-9);  // corner (0.1, 0.1)
+  room.castScanWalls(2.0 - 1e-9, 1.05, dx, dy, 0.0, M_PI / 4, 8, 8.0, got, WallMethod::kSweep);
+  EXPECT_NEAR(got[0], 1e-9, 1e-12);
+  room.castScanWalls(1.05, 1.05, dx, dy, 0.0, M_PI / 4, 1, 0.95 - 1e-9, got, WallMethod::kSweep);
+  EXPECT_EQ(got[0], 0.95 - 1e-9);
+  open_grid.castScanWalls(1.05, 1.05, dx, dy, 0.0, M_PI / 4, 8, 8.0, got, WallMethod::kSweep);
+  EXPECT_EQ(got[2], 8.0);  // leaves the grid
+  EXPECT_EQ(got[4], 8.0);
+  // A direction that is not finite is refused, whichever the method.
+  const double bad_x[2] = { 1.0, std::nan("") }, bad_y[2] = { 0.0, 1.0 };
+  for (WallMethod m : { WallMethod::kAuto, WallMethod::kSweep, WallMethod::kGridWalk })
+    EXPECT_THROW(room.castScanWalls(1.05, 1.05, bad_x, bad_y, 0.0, 1.0, 2, 8.0, got, m),
+                 std::invalid_argument);
+}
+
+TEST(WallSweep, ScansFromCellCentresAtDiagonalsMatchTheWalk)
+{
+  // Beams every 45 degrees from cell centres run exactly through cell corners, where the
+  // walk's tie rule decides; the sweep must reproduce it in block and cave maps alike.
+  const unsigned w = 50, h = 40;
+  const double res = 0.05;
+  std::mt19937 rng(9);
+  const double d = std::sqrt(0.5);
+  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
+  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  int compared = 0;
+  for (int map = 0; map < 6; ++map)
+  {
+    const std::vector<uint8_t> cells = map % 2 ? caveMap(w, h, rng) : blockMap(w, h, rng);
+    const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
+    for (unsigned cy = 0; cy < h; cy += 3)
+      for (unsigned cx = 0; cx < w; cx += 3)
+      {
+        if (cells[cy * w + cx])
+          continue;
+        double got[8], want[8];
+        const double x = (cx + 0.5) * res, y = (cy + 0.5) * res;
+        grid.castScanWalls(x, y, dx, dy, 0.0, M_PI / 4, 8, 3.0, got, WallMethod::kSweep);
+        grid.castFan(x, y, dx, dy, 8, 3.0, want);
+        for (int i = 0; i < 8; ++i)
+          ASSERT_NEAR(got[i], want[i], 1e-12) << "map " << map << " cell " << cx << ", " << cy
+                                              << " beam " << i;
+        compared += 8;
+      }
+  }
+  EXPECT_GT(compared, 2000);
+}
+
+TEST(WallSweep, AnyMethodGivesTheSameScan)
+{
+  // kAuto picks the walk where many faces are in range (a cave) and the sweep in open rooms;
+  // castScan's results must not depend on that choice. Also an offset origin.
+  std::mt19937 rng(33);
+  const unsigned w = 160, h = 120;
+  const std::vector<uint8_t> cave = caveMap(w, h, rng);
+  std::vector<uint8_t> room(static_cast<size_t>(w) * h, 0);
+  for (unsigned x = 0; x < w; ++x)
+    room[x] = room[(h - 1) * w + x] = 1;
+  for (unsigned y = 0; y < h; ++y)
+    room[y * w] = room[y * w + w - 1] = room[y * w + 80] = y < 90 ? 1 : 0;
+  const Layout l{ 360, -M_PI, 2 * M_PI / 360 };
+  std::uniform_real_distribution<double> ux(-2.0, 6.0), uy(1.0, 7.0), ua(-M_PI, M_PI);
+  for (const std::vector<uint8_t>* cells : { &cave, static_cast<const std::vector<uint8_t>*>(&room) })
+  {
+    const GridRaycaster grid(*cells, w, h, 0.05, -2.0, 1.0);
+    int scans = 0;
+    for (int k = 0; k < 200 && scans < 30; ++k)
+    {
+      const double x = ux(rng), y = uy(rng);
+      if (grid.occupiedAt(x, y))
+        continue;
+      ++scans;
+      Layout yawed = l;
+      yawed.first_angle += ua(rng);
+      const std::vector<double> a = castWalls(grid, x, y, yawed, 8.0, WallMethod::kAuto);
+      const std::vector<double> s = castWalls(grid, x, y, yawed, 8.0, WallMethod::kSweep);
+      const std::vector<double> g = castWalls(grid, x, y, yawed, 8.0, WallMethod::kGridWalk);
+      for (int i = 0; i < l.n; ++i)
+      {
+        ASSERT_NEAR(s[i], g[i], 1e-9) << "beam " << i;
+        ASSERT_NEAR(a[i], g[i], 1e-9) << "beam " << i;
+        // As castScan reports them (floats): identical.
+        ASSERT_EQ(static_cast<float>(s[i]), static_cast<float>(g[i])) << "beam " << i;
+      }
+    }
+    EXPECT_EQ(scans, 30);
+  }
+}

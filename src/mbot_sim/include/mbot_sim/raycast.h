@@ -7,7 +7,12 @@
  * than range_min reads -Inf.
  *
  * How it is fast (details in raycast.cpp):
- * - the grid keeps clearance maps (how far every cell is from the walls a ray could still
+ * - whole scans against the walls are an angular sweep: at map load the boundary between free
+ *   and occupied cells is cut into axis-aligned wall faces, bucketed in tiles; a scan visits
+ *   the faces in range that face the sensor, and each face tests only the beams inside the
+ *   angle it covers, keeping the nearest hit per beam (an angular z-buffer);
+ * - single rays, and scans among very many faces (cave-like maps), walk the grid instead: the
+ *   grid keeps clearance maps (how far every cell is from the walls a ray could still
  *   hit), so a ray jumps through open space in a few long steps and walks cell by cell only
  *   next to walls; the sensor cell's clearances are looked up once per scan, and the long
  *   steps of a few beams at a time are interleaved;
@@ -28,6 +33,14 @@ namespace mbot_sim
 class GridRaycaster;
 class ShapeSet;
 struct ScanSpec;
+
+/// @brief How GridRaycaster::castScanWalls() finds the walls. Both give the same ranges.
+enum class WallMethod
+{
+  kAuto,      ///< the sweep, unless the grid walk is expected to be faster (many faces in range)
+  kSweep,     ///< angular sweep over the wall faces (falls back to the walk where it cannot work)
+  kGridWalk,  ///< trace every beam through the cells (castFan)
+};
 
 /// @brief Cast a whole scan against the grid and the shapes. `ranges` gets `beams` values [m]
 ///        (+Inf: no return within range_max; -Inf: return closer than range_min).
@@ -67,6 +80,18 @@ public:
   void castFan(double x, double y, const double* dir_x, const double* dir_y, int n,
                double max_range, double* ranges) const;
 
+  /// @brief As castFan() for the beams of a scan: beam i points along the world angle
+  ///        first_angle + i * increment [rad] and (dir_x[i], dir_y[i]) is its unit vector.
+  ///        The angles let the sweep compute which beams a wall face covers directly.
+  /// @throws std::invalid_argument for a direction that is not finite
+  void castScanWalls(double x, double y, const double* dir_x, const double* dir_y,
+                     double first_angle, double increment, int n, double max_range,
+                     double* ranges, WallMethod method = WallMethod::kAuto) const;
+
+  /// @brief Number of wall faces (merged runs of cell edges between a free and an occupied
+  ///        cell) the sweep works with.
+  size_t wallFaceCount() const { return wall_face_count_; }
+
   /// @brief True when the point (x, y) [m] is inside an occupied cell.
   bool occupiedAt(double x, double y) const;
 
@@ -86,8 +111,24 @@ public:
   double originX() const { return origin_x_; }
   double originY() const { return origin_y_; }
 
+  /// @brief One wall face [cells]: the cell edges on grid line `line` (x = line for a
+  ///        vertical face, y = line for a horizontal one) from `lo` to `hi`, between free and
+  ///        occupied cells. `id` tells copies of a face in several tiles apart.
+  struct WallFace
+  {
+    int32_t line;
+    int32_t lo;
+    int32_t hi;
+    uint32_t id;
+  };
+
 private:
   void computeClearance();
+  void extractWallFaces();
+  /// The angular sweep of castScanWalls(); false (nothing done) where the walk is to be used.
+  bool sweepWalls(double x, double y, const double* dir_x, const double* dir_y,
+                  double first_angle, double increment, int n, double max_range, double* ranges,
+                  WallMethod method) const;
 
   unsigned size_x_ = 0;
   unsigned size_y_ = 0;
@@ -105,6 +146,16 @@ private:
   /// cell, so it may jump farther. These are what the ray tracing reads: (size_x + 2) x
   /// (size_y + 2) with a border of free cells, wall cells marked 0 (see raycast.cpp).
   std::array<std::vector<uint8_t>, 4> quadrant_clearance_;
+
+  /// Wall faces by tile (kTileCells square, see raycast.cpp) and by side, the way the free
+  /// side looks (0: -x, 1: +x, 2: -y, 3: +y): tile t's faces of side s are
+  /// tile_faces_[tile_start_[4 t + s] .. tile_start_[4 t + s + 1]). A face crossing tiles is
+  /// copied into each.
+  std::vector<WallFace> tile_faces_;
+  std::vector<uint32_t> tile_start_;
+  int tiles_x_ = 0;
+  int tiles_y_ = 0;
+  size_t wall_face_count_ = 0;
 };
 
 /// @brief A circle [m] (robot, cylinder); `owner` lets a robot's laser ignore its own body.
