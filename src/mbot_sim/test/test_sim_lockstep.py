@@ -75,6 +75,37 @@ def sim_settings():
     return rospy.get_param("/stage_node/lockstep_period"), step
 
 
+def answer_boundaries(watch, period, answer, warm_up=0):
+    """Play a slow node: ANSWERS times, wait until sim time passes a boundary, "compute" for
+    ANSWER_DELAY wall seconds, then call answer(boundary). The first `warm_up` answers are not
+    checked; for the others `watch` records how far sim time gets past the last answer.
+    @return (sim seconds, wall seconds, violations, largest lead) of the checked answers"""
+    boundary = lambda: math.floor(watch.now() / period + 1e-6) * period  # noqa: E731
+    answered = None
+    for i in range(warm_up + ANSWERS):
+        wait_for(lambda: answered is None or boundary() > answered + 1e-6, 2.0, "sim time to pass a boundary")
+        b = boundary()
+        if i == warm_up:
+            wall_start, sim_start = time.time(), b
+        time.sleep(ANSWER_DELAY)
+        answered = b
+        if i >= warm_up:
+            with watch.lock:  # before answering: the sim cannot move on before it gets the answer
+                watch.last_answered = b
+        answer(b)
+    sim_run, wall_run = watch.now() - sim_start, time.time() - wall_start
+    with watch.lock:
+        watch.last_answered = None
+        return sim_run, wall_run, list(watch.violations), watch.worst_lead
+
+
+def wait_for_release(watch, what):
+    """After the slow node stopped: one wall timeout later sim time runs on (5 s sim in < 5 s wall)."""
+    t0, w0 = watch.now(), time.time()
+    wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after %s stopped" % what)
+    print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
+
+
 class SimLockstep(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -87,7 +118,6 @@ class SimLockstep(unittest.TestCase):
         watch = ClockWatch(limit)
         pub = rospy.Publisher("/tf", TFMessage, queue_size=10, tcp_nodelay=True)
         wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
-        boundary = lambda: math.floor(watch.now() / period + 1e-6) * period  # noqa: E731
 
         def publish(stamp):
             t = TransformStamped()
@@ -98,34 +128,14 @@ class SimLockstep(unittest.TestCase):
             pub.publish(TFMessage([t]))
 
         # Until the first transform arrives the sim runs free: warm up (unchecked) until it holds.
-        published = None
-        for i in range(WARM_UP + ANSWERS):
-            wait_for(lambda: published is None or boundary() > published + 1e-6, 2.0, "sim time to pass a boundary")
-            b = boundary()
-            if i == WARM_UP:
-                wall_start, sim_start = time.time(), b
-            time.sleep(ANSWER_DELAY)
-            published = b
-            if i >= WARM_UP:
-                with watch.lock:
-                    watch.last_answered = b
-            publish(b)
-        sim_run = watch.now() - sim_start
-        wall_run = time.time() - wall_start
-        with watch.lock:
-            watch.last_answered = None
-            violations, worst = list(watch.violations), watch.worst_lead
+        sim_run, wall_run, violations, worst = answer_boundaries(watch, period, publish, warm_up=WARM_UP)
         print("localization: %.2f s sim in %.2f s wall (%d transforms); largest lead over the newest stamp %.3f s "
               "(allowed %.3f s)" % (sim_run, wall_run, ANSWERS, worst, limit))
         self.assertEqual(len(violations), 0, "sim time ran ahead of the localization (stamp, sim time): %s"
                          % violations[:5])
         # Each transform releases sim time up to the first boundary more than `lag` past its stamp.
         self.assertLess(sim_run, ANSWERS * limit + limit)
-
-        # Stop publishing: after one wall timeout the localization is not waited for any more.
-        t0, w0 = watch.now(), time.time()
-        wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after the localization stopped")
-        print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
+        wait_for_release(watch, "the localization")
 
     def test_slow_controller_holds_sim_time_and_release(self):
         period, step = sim_settings()
@@ -133,28 +143,11 @@ class SimLockstep(unittest.TestCase):
         watch = ClockWatch(limit)
         pub = rospy.Publisher("/robot_0/cmd_vel", Twist, queue_size=10, tcp_nodelay=True)
         wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
-        boundary = lambda: math.floor(watch.now() / period + 1e-6) * period  # noqa: E731
 
         # Start driving; the first command makes robot_0 driven, from then on sim time waits.
         pub.publish(Twist())
         time.sleep(0.1)
-
-        answered = None
-        wall_start = time.time()
-        sim_start = watch.now()
-        for _ in range(ANSWERS):
-            wait_for(lambda: answered is None or boundary() > answered + 1e-6, 2.0, "sim time to pass a boundary")
-            b = boundary()
-            time.sleep(ANSWER_DELAY)
-            answered = b
-            with watch.lock:  # before publishing: the sim cannot move on before it gets it
-                watch.last_answered = b
-            pub.publish(Twist())
-        sim_driven = watch.now() - sim_start
-        wall_driven = time.time() - wall_start
-        with watch.lock:
-            watch.last_answered = None
-            violations, worst = list(watch.violations), watch.worst_lead
+        sim_driven, wall_driven, violations, worst = answer_boundaries(watch, period, lambda _b: pub.publish(Twist()))
         print("driving: %.2f s sim in %.2f s wall (%d answers); largest lead over the last answer %.3f s "
               "(allowed %.3f s)" % (sim_driven, wall_driven, ANSWERS, worst, limit))
         self.assertEqual(len(violations), 0, "sim time ran ahead of the answered boundary (answered, sim time): %s"
@@ -162,11 +155,7 @@ class SimLockstep(unittest.TestCase):
         # Each answer released about one period: sim time moved on, but only that far.
         self.assertGreater(sim_driven, (ANSWERS - 5) * period)
         self.assertLess(sim_driven, (ANSWERS + 3) * period)
-
-        # Stop sending: after one wall timeout robot_0 is not waited for any more.
-        t0, w0 = watch.now(), time.time()
-        wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after the commands stopped")
-        print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
+        wait_for_release(watch, "the commands")
 
 
 if __name__ == "__main__":
