@@ -231,9 +231,16 @@ void StageRos::publishRobotList()
   nh_.setParam("stage/robots", list);
 }
 
+/// /stage/markers: obstacles (ns "obstacles", "moving_obstacles") and every robot as a disc of its
+/// footprint radius with its name above it (ns "robots", "robot_names"), so that a fleet view
+/// shows who is where even without each robot's RobotModel. The array starts with DELETEALL:
+/// removed robots disappear, and rviz draws the array as one consistent picture.
 void StageRos::publishMarkers()
 {
   visualization_msgs::MarkerArray array;
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  array.markers.push_back(clear);
   int index = 0;
   for (const ObstacleState& o : world_->obstacles())
   {
@@ -257,6 +264,40 @@ void StageRos::publishMarkers()
     m.color.b = o.moving ? 0.1f : 0.3f;
     m.color.a = 1.0f;
     m.text = o.name;
+    array.markers.push_back(m);
+  }
+  for (int id : world_->robotIds())
+  {
+    const Pose2D pose = world_->groundTruth(id);
+    const float hue = static_cast<float>(id % 6) / 6.0f;  // a stable colour per robot
+    visualization_msgs::Marker m;
+    m.header.frame_id = "map";
+    m.header.stamp.fromSec(world_->time());
+    m.ns = "robots";
+    m.id = id;
+    m.action = visualization_msgs::Marker::ADD;
+    m.type = visualization_msgs::Marker::CYLINDER;
+    m.pose.position.x = pose.x;
+    m.pose.position.y = pose.y;
+    m.pose.position.z = 0.05;
+    m.pose.orientation.w = 1.0;
+    m.scale.x = m.scale.y = 2.0 * world_->robotModel(id).footprint_radius;
+    m.scale.z = 0.1;
+    m.color.r = 0.5f + 0.5f * std::cos(2.0f * static_cast<float>(M_PI) * hue);
+    m.color.g = 0.5f + 0.5f * std::cos(2.0f * static_cast<float>(M_PI) * (hue - 1.0f / 3.0f));
+    m.color.b = 0.5f + 0.5f * std::cos(2.0f * static_cast<float>(M_PI) * (hue - 2.0f / 3.0f));
+    m.color.a = 0.9f;
+    array.markers.push_back(m);
+
+    m.ns = "robot_names";
+    m.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    m.pose.position.y += world_->robotModel(id).footprint_radius + 0.35;
+    m.pose.position.z = 0.5;
+    m.scale.x = m.scale.y = 0.0;
+    m.scale.z = 0.45;  // text height [m]
+    m.color.r = m.color.g = m.color.b = 1.0f;
+    m.color.a = 1.0f;
+    m.text = world_->robotName(id);
     array.markers.push_back(m);
   }
   marker_pub_.publish(array);
@@ -362,8 +403,6 @@ void StageRos::run()
   ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
   ros::WallTime anchor_wall = ros::WallTime::now();
   double anchor_sim = world_->time();
-  bool has_movers = false;
-  for (const auto& o : world_->obstacles()) has_movers = has_movers || o.moving;
   next_boundary_ = (std::floor(world_->time() / params_.lockstep_period) + 1.0) * params_.lockstep_period;
 
   while (ros::ok())
@@ -391,7 +430,7 @@ void StageRos::run()
     }
     publishClock();
     if (params_.lockstep) noteBoundary();
-    if (has_movers && world_->time() + 1e-9 >= next_marker_time_)
+    if (world_->time() + 1e-9 >= next_marker_time_ && marker_pub_.getNumSubscribers() > 0)  // none: save the work
     {
       publishMarkers();
       next_marker_time_ = world_->time() + 1.0 / params_.marker_rate;

@@ -20,6 +20,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
+from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 from sim_test_tools import (Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
@@ -153,6 +154,20 @@ class SimBasics(unittest.TestCase):
         self.assertAlmostEqual(t.transform.translation.x, 0.05, delta=1e-3)
         self.assertAlmostEqual(t.transform.translation.y, 0.0, delta=1e-3)
         self.assertAlmostEqual(t.transform.translation.z, 0.16, delta=1e-3)
+
+    def test_6_markers_show_every_robot_where_it_is(self):
+        array = rospy.wait_for_message("/stage/markers", MarkerArray, timeout=30.0)
+        stamp = max(m.header.stamp for m in array.markers)
+        discs = {m.id: m for m in array.markers if m.ns == "robots"}
+        names = sorted(m.text for m in array.markers if m.ns == "robot_names")
+        self.assertEqual(array.markers[0].action, Marker.DELETEALL)
+        self.assertEqual(names, ["robot_0", "robot_1", "robot_2"])
+        self.assertEqual(len(discs), 3)
+        # robot_1 never moves: its disc is where its ground truth is, footprint-sized
+        truth = self.truth["robot_1"].latest().pose.pose.position
+        disc = [m for m in discs.values() if abs(m.pose.position.x - truth.x) < 0.01 and abs(m.pose.position.y - truth.y) < 0.01]
+        self.assertEqual(len(disc), 1, "no disc at robot_1's pose (%.2f, %.2f) at t=%.2f" % (truth.x, truth.y, stamp.to_sec()))
+        self.assertAlmostEqual(disc[0].scale.x, 2 * RADIUS, delta=1e-6)
 
 
 if __name__ == "__main__":
