@@ -430,10 +430,13 @@ void StageRos::run()
     }
     publishClock();
     if (params_.lockstep) noteBoundary();
-    if (world_->time() + 1e-9 >= next_marker_time_ && marker_pub_.getNumSubscribers() > 0)  // none: save the work
+    // Markers are for eyes: at ~marker_rate in sim time, at most 30 Hz wall, only while someone listens.
+    if (world_->time() + 1e-9 >= next_marker_time_ && ros::WallTime::now() >= next_marker_wall_ &&
+        marker_pub_.getNumSubscribers() > 0)
     {
       publishMarkers();
       next_marker_time_ = world_->time() + 1.0 / params_.marker_rate;
+      next_marker_wall_ = ros::WallTime::now() + ros::WallDuration(1.0 / 30.0);
     }
 
     if (real_time_factor_ > 0.0)

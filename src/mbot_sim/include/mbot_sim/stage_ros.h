@@ -144,6 +144,7 @@ private:
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
   double next_marker_time_ = 0.0;
+  ros::WallTime next_marker_wall_;
 
   // lockstep (see waitForControllers())
   long boundary_count_ = 0;           ///< boundaries published so far
