@@ -42,10 +42,10 @@ namespace mbot_navigation
  */
 struct OmplConfig
 {
-  std::string planner = "rrtstar";  ///< "rrtstar", "prmstar" or "rrtconnect"
-  double time_limit = 1.0;          ///< planning time [s]; RRT* and PRM* use all of it to
+  std::string planner = "rrtconnect";  ///< "rrtconnect" (fast, repeatable), "rrtstar" or "prmstar"
+  double time_limit = 0.5;          ///< planning time [s]; RRT* and PRM* use all of it to
                                     ///< improve the path, RRT-Connect stops at its first path
-  double simplify_time_limit = 0.5; ///< at most this long [s] for the cost-aware simplification
+  double simplify_time_limit = 0.2; ///< at most this long [s] for the cost-aware simplification
                                     ///< (it usually converges much sooner)
   double cost_weight = 4.0;         ///< a metre through a cell of cost c counts as
                                     ///< 1 + cost_weight * c / 252 m; 0: only the length matters.
