@@ -1,7 +1,9 @@
 #include "mbot_navigation/inflation_layer.h"
 
+#include "mbot_navigation/distance_transform.h"
+
+#include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 namespace mbot_navigation
@@ -99,8 +101,9 @@ void InflationLayer::updateCosts(Costmap2D& master, const CellWindow& w)
     for (int x = 0; x < W; ++x) out[x] = std::min(out[x], next[x] + 1);
   }
 
-  // Pass 2: per row of the window, the lower envelope of parabolas (x - q)^2 + col(q)^2 gives the
-  // exact squared Euclidean distance (Felzenszwalb & Huttenlocher 2012).
+  // Pass 2: per row of the window, the 1-D transform of the squared column distances gives the
+  // exact squared Euclidean distance (Felzenszwalb & Huttenlocher 2012, distance_transform.h).
+  // Distances stay capped ints, so the costs come from an exact table lookup.
   row_f_.resize(W);
   d2_.resize(W);
   env_v_.resize(W);
@@ -118,34 +121,7 @@ void InflationLayer::updateCosts(Costmap2D& master, const CellWindow& w)
     }
     if (!any) continue;  // no lethal cell within R rows: nothing to inflate in this row
 
-    int k = 0;
-    env_v_[0] = 0;
-    env_z_[0] = -std::numeric_limits<double>::infinity();
-    env_z_[1] = std::numeric_limits<double>::infinity();
-    for (int q = 1; q < W; ++q)
-    {
-      // Where parabola q starts to be below the envelope's last one; drop the ones it hides.
-      // (env_z_[0] is -inf, so k never goes below 0.)
-      double s;
-      while (true)
-      {
-        const int v = env_v_[k];
-        s = ((row_f_[q] + q * q) - (row_f_[v] + v * v)) / (2.0 * (q - v));
-        if (s > env_z_[k]) break;
-        --k;
-      }
-      ++k;
-      env_v_[k] = q;
-      env_z_[k] = s;
-      env_z_[k + 1] = std::numeric_limits<double>::infinity();
-    }
-    k = 0;
-    for (int q = 0; q < W; ++q)
-    {
-      while (env_z_[k + 1] < q) ++k;
-      const int dq = q - env_v_[k];
-      d2_[q] = dq * dq + row_f_[env_v_[k]];
-    }
+    squaredDistanceTransform1d(row_f_.data(), W, d2_.data(), env_v_.data(), env_z_.data());
 
     uint8_t* row = out_costs + master.index(0, y);
     for (int x = w.x0; x < w.xn; ++x)

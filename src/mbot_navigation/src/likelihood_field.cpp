@@ -1,8 +1,9 @@
 #include "mbot_navigation/likelihood_field.h"
 
+#include "mbot_navigation/distance_transform.h"
+
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -14,39 +15,6 @@ namespace
 {
 /// "No obstacle" for the transform: large but finite, so that differences stay finite.
 constexpr double FAR = 1e20;
-
-/// One-dimensional squared distance transform (Felzenszwalb & Huttenlocher): d[q] is the lowest
-/// parabola (q - p)^2 + f[p] over all p. `v` and `z` hold the lower envelope of the parabolas.
-void transform1d(const std::vector<double>& f, std::vector<double>& d, std::vector<int>& v,
-                 std::vector<double>& z)
-{
-  const int n = static_cast<int>(f.size());
-  int k = 0;
-  v[0] = 0;
-  z[0] = -std::numeric_limits<double>::infinity();
-  z[1] = std::numeric_limits<double>::infinity();
-  for (int q = 1; q < n; ++q)
-  {
-    // where the parabola from q crosses the rightmost parabola of the envelope
-    double s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
-    while (s <= z[k])
-    {
-      --k;
-      s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
-    }
-    ++k;
-    v[k] = q;
-    z[k] = s;
-    z[k + 1] = std::numeric_limits<double>::infinity();
-  }
-  k = 0;
-  for (int q = 0; q < n; ++q)
-  {
-    while (z[k + 1] < q) ++k;
-    const double dq = q - v[k];
-    d[q] = dq * dq + f[v[k]];
-  }
-}
 }  // namespace
 
 std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width,
@@ -55,26 +23,23 @@ std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupie
   std::vector<double> grid(occupied.size());
   for (size_t i = 0; i < occupied.size(); ++i) grid[i] = occupied[i] ? 0.0 : FAR;
 
+  // Scratch of the 1-D pass, sized once for the longer side and reused by every column and row.
   const unsigned longest = std::max(width, height);
   std::vector<double> f(longest), d(longest), z(longest + 1);
   std::vector<int> v(longest);
 
   // pass 1: along every column (y), then pass 2: along every row (x) on the column result
-  f.resize(height);
-  d.resize(height);
   for (unsigned x = 0; x < width; ++x)
   {
     for (unsigned y = 0; y < height; ++y) f[y] = grid[static_cast<size_t>(y) * width + x];
-    transform1d(f, d, v, z);
+    squaredDistanceTransform1d(f.data(), static_cast<int>(height), d.data(), v.data(), z.data());
     for (unsigned y = 0; y < height; ++y) grid[static_cast<size_t>(y) * width + x] = d[y];
   }
-  f.resize(width);
-  d.resize(width);
   for (unsigned y = 0; y < height; ++y)
   {
     const size_t row = static_cast<size_t>(y) * width;
     for (unsigned x = 0; x < width; ++x) f[x] = grid[row + x];
-    transform1d(f, d, v, z);
+    squaredDistanceTransform1d(f.data(), static_cast<int>(width), d.data(), v.data(), z.data());
     for (unsigned x = 0; x < width; ++x) grid[row + x] = d[x];
   }
   return grid;
