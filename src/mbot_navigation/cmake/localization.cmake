@@ -44,14 +44,8 @@ install(TARGETS fake_localization pf_localization map_server
 
 # ---- tests: gtest without a master, rostests with one
 if(CATKIN_ENABLE_TESTING)
-  catkin_add_gtest(test_particle_filter test/test_particle_filter.cpp)
-  if(TARGET test_particle_filter)
-    target_link_libraries(test_particle_filter mbot_localization)
-  endif()
-  catkin_add_gtest(test_map_server_paths test/test_map_server_paths.cpp)
-  if(TARGET test_map_server_paths)
-    target_link_libraries(test_map_server_paths mbot_localization)
-  endif()
+  mbot_add_gtest(test_particle_filter mbot_localization)
+  mbot_add_gtest(test_map_server_paths mbot_localization)
 
   find_package(rostest REQUIRED)
   add_rostest(test/fake_localization.test)

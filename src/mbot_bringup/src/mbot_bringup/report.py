@@ -30,12 +30,28 @@ def load_map_for_plot(world_yaml):
     return image, (ox, ox + w * res, oy, oy + h * res)
 
 
-def plot_trajectories(rec, world_yaml, path):
+def new_figure(width, height):
+    """A matplotlib figure and axes drawn off-screen (no display needed)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    return plt.subplots(figsize=(width, height))
 
-    fig, ax = plt.subplots(figsize=(7, 7))
+
+def save_figure(fig, ax, path, title, xlabel, ylabel):
+    """Label the axes, add the legend, write the PNG and free the figure."""
+    import matplotlib.pyplot as plt
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_trajectories(rec, world_yaml, path):
+    fig, ax = new_figure(7, 7)
     image, extent = load_map_for_plot(world_yaml)
     ax.imshow(image, cmap="gray", extent=extent, origin="upper", vmin=0, vmax=255)
     for name in sorted(rec["robots"]):
@@ -50,21 +66,11 @@ def plot_trajectories(rec, world_yaml, path):
         ax.plot(g["x"], g["y"], "k*", ms=10)
     for c in rec["contacts"]:
         ax.plot(c["x"], c["y"], "rx", ms=9)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title("Ground-truth trajectories (o start, arrow end, * goal, x contact)")
-    ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save_figure(fig, ax, path, "Ground-truth trajectories (o start, arrow end, * goal, x contact)", "x [m]", "y [m]")
 
 
 def plot_speeds(rec, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 3))
+    fig, ax = new_figure(7, 3)
     for name in sorted(rec["robots"]):
         r = rec["robots"][name]
         t, x, y = np.array(r["t"]), np.array(r["x"]), np.array(r["y"])
@@ -72,13 +78,7 @@ def plot_speeds(rec, path):
             continue
         speed = np.hypot(np.diff(x), np.diff(y)) / np.maximum(np.diff(t), 1e-9)
         ax.plot(t[1:] - t[0], speed, lw=1, label=name)
-    ax.set_xlabel("sim time [s]")
-    ax.set_ylabel("speed [m/s]")
-    ax.set_title("Ground-truth speed")
-    ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save_figure(fig, ax, path, "Ground-truth speed", "sim time [s]", "speed [m/s]")
 
 
 def summary_table(rec):
