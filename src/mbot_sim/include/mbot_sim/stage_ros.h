@@ -55,7 +55,7 @@ struct StageParams
   double lockstep_active_timeout = 0.5;  ///< ~lockstep_active_timeout: a robot is driven while its
                                          ///< last cmd_vel is at most this old [s sim time]
   double lockstep_wall_timeout = 0.5;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
-  double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: a driven robot's localization
+  double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: each robot's localization
                                            ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
 };
 
@@ -77,8 +77,8 @@ public:
 
   /// @brief Step the world until shutdown, paced by the real-time factor (0: as fast as
   ///        possible); callbacks and services are served between steps, on this thread.
-  ///        With ~lockstep, sim time also waits for the driven robots' controllers at every
-  ///        ~lockstep_period boundary (see waitForControllers()).
+  ///        With ~lockstep, sim time also waits for the driven robots' controllers and every
+  ///        robot's localization at each ~lockstep_period boundary (see waitForControllers()).
   void run();
 
   // SensorListener: called by World::step()
