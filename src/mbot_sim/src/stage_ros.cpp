@@ -148,6 +148,8 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   services_.push_back(nh_.advertiseService("unpause_physics", &StageRos::onUnpause, this));
   services_.push_back(nh_.advertiseService("spawn_robot", &StageRos::onSpawn, this));
   services_.push_back(nh_.advertiseService("remove_robot", &StageRos::onRemove, this));
+  services_.push_back(nh_.advertiseService("spawn_obstacle", &StageRos::onSpawnObstacle, this));
+  services_.push_back(nh_.advertiseService("remove_obstacle", &StageRos::onRemoveObstacle, this));
   services_.push_back(nh_.advertiseService("teleport_robot", &StageRos::onTeleport, this));
   services_.push_back(nh_.advertiseService("set_fault", &StageRos::onSetFault, this));
   world_->setListener(this);
@@ -608,6 +610,47 @@ bool StageRos::onRemove(mbot_msgs::RemoveRobot::Request& req, mbot_msgs::RemoveR
     ROS_INFO("stage_node: %s", res.message.c_str());
   }
   catch (const std::exception& e)  // SimError: unknown robot, bad pose or value
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+/// The latched /stage/markers are published at once (not at the next marker tick), so that a
+/// late subscriber and a test get the obstacles as they are now, stamped with the sim time of
+/// the change.
+bool StageRos::onSpawnObstacle(mbot_msgs::SpawnObstacle::Request& req, mbot_msgs::SpawnObstacle::Response& res)
+{
+  try
+  {
+    world_->addObstacle(obstacleFromRequest(req.name, req.shape, req.length, req.width, req.radius,
+                                            Pose2D{req.pose.x, req.pose.y, req.pose.theta}));
+    publishMarkers();
+    res.success = true;
+    res.message = "spawned obstacle " + req.name + " (" + req.shape + ")";
+    ROS_INFO("stage_node: %s at (%.2f, %.2f, %.2f) at sim time %.3f s", res.message.c_str(), req.pose.x, req.pose.y,
+             req.pose.theta, world_->time());
+  }
+  catch (const std::exception& e)  // SimError: duplicate name, bad shape or size, on a robot, ...
+  {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool StageRos::onRemoveObstacle(mbot_msgs::RemoveObstacle::Request& req, mbot_msgs::RemoveObstacle::Response& res)
+{
+  try
+  {
+    world_->removeObstacle(req.name);
+    publishMarkers();
+    res.success = true;
+    res.message = "removed obstacle " + req.name;
+    ROS_INFO("stage_node: %s at sim time %.3f s", res.message.c_str(), world_->time());
+  }
+  catch (const std::exception& e)  // SimError: unknown obstacle, a robot's name, ...
   {
     res.success = false;
     res.message = e.what();

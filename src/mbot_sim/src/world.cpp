@@ -111,6 +111,27 @@ std::string formatPoint(double x, double y)
   return out.str();
 }
 
+std::string formatNumber(double v)
+{
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+/// The problem with an obstacle's sizes, as the world file reader words it ("" when fine).
+std::string checkShapeSizes(const ShapeConfig& shape)
+{
+  auto positive = [](const std::string& key, double v) {
+    return v > 0.0 ? std::string() : key + ": expected a number > 0 [m], got " + formatNumber(v);  // NaN too
+  };
+  if (shape.type == ShapeConfig::Type::BOX)
+  {
+    const std::string problem = positive("length", shape.length);
+    return problem.empty() ? positive("width", shape.width) : problem;
+  }
+  return positive("radius", shape.radius);
+}
+
 /// What a geom belongs to; ODE geoms point at it (dGeomSetData).
 struct BodyTag
 {
@@ -630,6 +651,13 @@ struct World::Impl
   void addObstacle(const ObstacleConfig& config)
   {
     claimName(config.name, "obstacle");
+    const std::string size_problem = checkShapeSizes(config.shape);
+    if (!size_problem.empty()) throw SimError("obstacle " + config.name + ": " + size_problem);
+    const Pose2D& pose = config.pose;
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw))
+      throw SimError("obstacle " + config.name + ": the pose is not finite");
+    if (!insideMap(pose.x, pose.y))
+      throw SimError("obstacle " + config.name + " at " + formatPoint(pose.x, pose.y) + " is outside the map");
     auto o = std::make_unique<Obstacle>();
     o->shape = config.shape;
     o->outline = outlineOf(config.shape);
@@ -650,6 +678,26 @@ struct World::Impl
     dSpaceAdd(static_space.get(), o->geom.get());
     names.insert(config.name);
     obstacles.push_back(std::move(o));
+  }
+
+  /// Between steps nothing else points at an obstacle: contact joints and hits live for one
+  /// step, contact pairs are keyed by uid (never reused), and the laser's shapes are rebuilt
+  /// from `obstacles` at every scan. So destroying the geom (it leaves its space) is enough.
+  void removeObstacle(const std::string& name)
+  {
+    const auto it = std::find_if(obstacles.begin(), obstacles.end(), [&](const auto& o) { return o->tag.name == name; });
+    if (it != obstacles.end())
+    {
+      names.erase(name);
+      obstacles.erase(it);
+      return;
+    }
+    if (name == "map") throw SimError("\"map\" is the walls, not an obstacle");
+    if (robotByName(name)) throw SimError("\"" + name + "\" is a robot, not an obstacle");
+    for (const auto& m : movers)
+      if (m->tag.name == name)
+        throw SimError("\"" + name + "\" is a moving obstacle; only static obstacles can be removed");
+    throw SimError("unknown obstacle \"" + name + "\"");
   }
 
   void addMovingObstacle(const MovingObstacleConfig& config)
@@ -1113,6 +1161,7 @@ int World::addRobot(const std::string& name, const RobotModel& model, const Pose
 }
 void World::removeRobot(const std::string& name) { impl_->removeRobot(name); }
 void World::addObstacle(const ObstacleConfig& obstacle) { impl_->addObstacle(obstacle); }
+void World::removeObstacle(const std::string& name) { impl_->removeObstacle(name); }
 void World::addMovingObstacle(const MovingObstacleConfig& obstacle) { impl_->addMovingObstacle(obstacle); }
 void World::setCommand(int robot, const Twist2D& command) { impl_->setCommand(robot, command); }
 void World::teleport(const std::string& name, const Pose2D& pose) { impl_->teleport(name, pose); }
@@ -1195,6 +1244,34 @@ std::vector<CellRect> mergeOccupiedCells(const OccupancyMap& map)
     }
   }
   return rects;
+}
+
+ObstacleConfig obstacleFromRequest(const std::string& name, const std::string& shape, double length, double width,
+                                   double radius, const Pose2D& pose)
+{
+  ObstacleConfig o;
+  o.name = name;
+  o.pose = pose;
+  // The world file reader's words: a box has a size, a cylinder a radius, and not the other.
+  if (shape == "box")
+  {
+    if (radius != 0.0) throw SimError("obstacle " + name + ": radius: a box has a size [length, width], not a radius");
+    o.shape.type = ShapeConfig::Type::BOX;
+    o.shape.length = length;
+    o.shape.width = width;
+  }
+  else if (shape == "cylinder")
+  {
+    if (length != 0.0 || width != 0.0)
+      throw SimError("obstacle " + name + ": length, width: a cylinder has a radius, not a size");
+    o.shape.type = ShapeConfig::Type::CYLINDER;
+    o.shape.radius = radius;
+  }
+  else
+  {
+    throw SimError("obstacle " + name + ": shape: expected box or cylinder, got \"" + shape + "\"");
+  }
+  return o;
 }
 
 std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& load_model, double watchdog_timeout)

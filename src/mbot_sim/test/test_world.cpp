@@ -598,6 +598,231 @@ TEST(Requests, SpawnTeleportRemoveAndTheirErrors)
   world.step();
 }
 
+/// Step until the robot's next scan (at most 1 s); return it.
+std::vector<float> nextScan(World& world, Recorder& rec, int robot)
+{
+  const size_t before = rec.scans[robot].size();
+  for (int i = 0; i < 100 && rec.scans[robot].size() == before; ++i) world.step();
+  if (rec.scans[robot].size() == before) ADD_FAILURE() << "no scan within 1 s";
+  return rec.scans[robot].empty() ? std::vector<float>() : rec.scans[robot].back().ranges;
+}
+
+ObstacleConfig box(const std::string& name, double length, double width, const Pose2D& pose)
+{
+  ObstacleConfig o;
+  o.name = name;
+  o.shape.type = ShapeConfig::Type::BOX;
+  o.shape.length = length;
+  o.shape.width = width;
+  o.pose = pose;
+  return o;
+}
+
+/// The message of the SimError `f` throws ("" and a test failure when it throws none).
+template <class F>
+std::string errorOf(F f)
+{
+  try
+  {
+    f();
+  }
+  catch (const SimError& e)
+  {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a SimError";
+  return "";
+}
+
+TEST(Requests, SpawnedObstacleIsSeenFromTheNextScanAndGoneAfterRemoval)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int id = world.addRobot("robot_0", model, Pose2D{4.0, 4.0, 0.0});  // laser at x = 4.05
+  const size_t ahead = beamAt(model, 0.0), left = beamAt(model, kPi / 2);
+  const double wall_ahead = 9.9 - 4.05, wall_left = 7.9 - 4.0;  // east and north inner faces
+  run(world, 0.15);  // between two scans (0.1 s, 0.2 s)
+  ASSERT_EQ(rec.scans[id].size(), 1u);
+  EXPECT_NEAR(rec.scans[id][0].ranges[ahead], wall_ahead, 1e-3);
+
+  world.addObstacle(box("crate", 0.4, 0.6, Pose2D{6.0, 4.0, 0.0}));  // near face at x = 5.8
+  ObstacleConfig drum;
+  drum.name = "drum";
+  drum.shape.type = ShapeConfig::Type::CYLINDER;
+  drum.shape.radius = 0.25;
+  drum.pose = Pose2D{4.05, 6.0, 0.0};  // 2.0 - 0.25 m left of the laser
+  world.addObstacle(drum);
+  ASSERT_EQ(world.obstacles().size(), 2u);
+  std::vector<float> r = nextScan(world, rec, id);
+  EXPECT_NEAR(rec.scans[id].back().stamp, 0.2, 1e-9);  // the first scan after the spawn
+  EXPECT_NEAR(r[ahead], 5.8 - 4.05, 1e-3);
+  EXPECT_NEAR(r[left], 2.0 - 0.25, 1e-3);
+
+  world.removeObstacle("crate");
+  EXPECT_EQ(world.obstacles().size(), 1u);
+  EXPECT_EQ(world.obstacles().front().name, "drum");
+  r = nextScan(world, rec, id);
+  EXPECT_NEAR(r[ahead], wall_ahead, 1e-3);  // the wall again
+  EXPECT_NEAR(r[left], 2.0 - 0.25, 1e-3);   // the drum stays
+  world.removeObstacle("drum");
+  EXPECT_TRUE(world.obstacles().empty());
+  r = nextScan(world, rec, id);
+  EXPECT_NEAR(r[left], wall_left, 1e-3);
+
+  // The name is free again; a robot driven into the new crate stops at it, one contact with its name.
+  world.addObstacle(box("crate", 0.4, 0.6, Pose2D{5.0, 4.0, 0.0}));  // near face at x = 4.8
+  double max_x = 0.0;
+  for (int i = 0; i < 300; ++i)  // 3 s at up to 0.5 m/s: would be > 1 m, the crate is 0.65 m away
+  {
+    if (i % 10 == 0) world.setCommand(id, Twist2D{0.5, 0.0, 0.0});
+    world.step();
+    max_x = std::max(max_x, world.groundTruth(id).x);
+  }
+  EXPECT_LE(max_x + 0.15, 4.8) << "the footprint entered the crate";
+  EXPECT_NEAR(world.groundTruth(id).x, 4.8 - 0.15, 0.02);
+  EXPECT_EQ(rec.contactsBetween("robot_0", "crate"), 1);
+  EXPECT_EQ(rec.contacts.size(), 1u);
+
+  // Removed while the robot rests against it: the way is free, the robot drives on.
+  world.removeObstacle("crate");
+  drive(world, id, Twist2D{0.5, 0.0, 0.0}, 1.0);
+  EXPECT_GT(world.groundTruth(id).x, 4.8);
+  EXPECT_EQ(rec.contacts.size(), 1u);
+}
+
+TEST(Requests, ObstacleFromTheWorldFileCanBeRemoved)
+{
+  WorldConfig config;
+  config.file = "test.world.yaml";
+  config.map = kFixtures + "/room.yaml";
+  ObstacleConfig crate = box("crate_1", 1.0, 1.0, Pose2D{2.0, 2.0, 0.0});
+  crate.key = "obstacles[0]";
+  config.obstacles.push_back(crate);
+  auto world = buildWorld(config, [](const std::string&) { return diffModel(); });
+  ASSERT_EQ(world->obstacles().size(), 1u);
+  EXPECT_FALSE(world->isFree(2.0, 2.0, 0.15));
+  world->removeObstacle("crate_1");
+  EXPECT_TRUE(world->obstacles().empty());
+  EXPECT_TRUE(world->isFree(2.0, 2.0, 0.15));
+  world->addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});  // where the crate was
+}
+
+TEST(Requests, BadObstacleRequestsAreRefusedWithTheirReasonAndChangeNothing)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int id = world.addRobot("robot_0", model, Pose2D{2.0, 2.0, 0.0});
+  MovingObstacleConfig person;
+  person.name = "person_1";
+  person.shape.type = ShapeConfig::Type::CYLINDER;
+  person.shape.radius = 0.25;
+  person.waypoints = {{8.5, 1.0}, {8.5, 2.5}};  // behind the wall block: robot_0 cannot see it
+  world.addMovingObstacle(person);
+  world.addObstacle(box("crate", 0.4, 0.4, Pose2D{4.0, 2.0, 0.0}));  // near face at x = 3.8
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const Pose2D free_pose{3.0, 2.0, 0.0};  // in robot_0's laser beam, between it and the crate
+
+  struct Case
+  {
+    ObstacleConfig obstacle;
+    std::string message;
+  };
+  std::vector<Case> cases = {
+      {box("crate", 0.4, 0.4, free_pose), "duplicate name \"crate\": a body of that name exists already"},
+      {box("robot_0", 0.4, 0.4, free_pose), "duplicate name \"robot_0\""},
+      {box("person_1", 0.4, 0.4, free_pose), "duplicate name \"person_1\""},
+      {box("map", 0.4, 0.4, free_pose), "duplicate name \"map\""},
+      {box("bad name", 0.4, 0.4, free_pose),
+       "obstacle name: expected a name of letters, digits and _ (not starting with a digit), got \"bad name\""},
+      {box("1crate", 0.4, 0.4, free_pose), "obstacle name: expected a name of letters"},
+      {box("", 0.4, 0.4, free_pose), "obstacle name: expected a name of letters"},
+      {box("b", 0.0, 0.4, free_pose), "obstacle b: length: expected a number > 0 [m], got 0"},
+      {box("b", 0.4, -0.5, free_pose), "obstacle b: width: expected a number > 0 [m], got -0.5"},
+      {box("b", nan, 0.4, free_pose), "obstacle b: length: expected a number > 0 [m], got nan"},
+      {box("b", 0.4, 0.4, Pose2D{nan, 2.0, 0.0}), "obstacle b: the pose is not finite"},
+      {box("b", 0.4, 0.4, Pose2D{3.0, inf, 0.0}), "obstacle b: the pose is not finite"},
+      {box("b", 0.4, 0.4, Pose2D{3.0, 2.0, nan}), "obstacle b: the pose is not finite"},
+      {box("b", 0.4, 0.4, Pose2D{40.0, 2.0, 0.0}), "obstacle b at (40.00, 2.00) is outside the map"},
+      {box("b", 0.4, 0.4, Pose2D{2.0, -0.5, 0.0}), "obstacle b at (2.00, -0.50) is outside the map"},
+      {box("b", 0.4, 0.4, Pose2D{2.3, 2.0, 0.0}), "obstacle b at (2.30, 2.00) overlaps robot robot_0"},
+      {box("b", 0.4, 0.4, Pose2D{2.0, 2.3, 0.8}), "obstacle b at (2.00, 2.30) overlaps robot robot_0"},
+  };
+  ObstacleConfig cylinder;
+  cylinder.name = "c";
+  cylinder.shape.type = ShapeConfig::Type::CYLINDER;
+  cylinder.pose = free_pose;
+  cylinder.shape.radius = 0.0;
+  cases.push_back({cylinder, "obstacle c: radius: expected a number > 0 [m], got 0"});
+  cylinder.shape.radius = nan;
+  cases.push_back({cylinder, "obstacle c: radius: expected a number > 0 [m], got nan"});
+  cylinder.shape.radius = 0.3;
+  cylinder.pose = Pose2D{2.0, 1.6, 0.0};  // 0.4 m apart, radii 0.15 + 0.3
+  cases.push_back({cylinder, "obstacle c at (2.00, 1.60) overlaps robot robot_0"});
+
+  run(world, 0.1);
+  const std::vector<float> before = rec.scans[id].back().ranges;
+  const size_t ahead = beamAt(model, 0.0);
+  ASSERT_NEAR(before[ahead], 3.8 - 2.05, 1e-3);
+  for (const Case& c : cases)
+  {
+    const std::string message = errorOf([&] { world.addObstacle(c.obstacle); });
+    EXPECT_NE(message.find(c.message), std::string::npos) << "got: " << message << "\nexpected: " << c.message;
+  }
+  // Nothing changed: the same bodies, the same scan.
+  ASSERT_EQ(world.obstacles().size(), 2u);
+  EXPECT_EQ(world.obstacles()[0].name, "crate");
+  EXPECT_NEAR(world.obstacles()[0].pose.x, 4.0, 1e-12);
+  EXPECT_EQ(world.robotCount(), 1u);
+  const std::vector<float> after = nextScan(world, rec, id);
+  ASSERT_EQ(after.size(), before.size());
+  for (size_t i = 0; i < after.size(); ++i) EXPECT_EQ(after[i], before[i]) << "beam " << i;
+
+  // Removal: only static obstacles, by their name.
+  EXPECT_EQ(errorOf([&] { world.removeObstacle("nothing"); }), "unknown obstacle \"nothing\"");
+  EXPECT_EQ(errorOf([&] { world.removeObstacle("robot_0"); }), "\"robot_0\" is a robot, not an obstacle");
+  EXPECT_EQ(errorOf([&] { world.removeObstacle("person_1"); }),
+            "\"person_1\" is a moving obstacle; only static obstacles can be removed");
+  EXPECT_EQ(errorOf([&] { world.removeObstacle("map"); }), "\"map\" is the walls, not an obstacle");
+  EXPECT_EQ(world.obstacles().size(), 2u);
+  EXPECT_EQ(world.robotCount(), 1u);
+
+  // Touching a wall is allowed (the wall block is x in [7.0, 7.5]): as in a world file.
+  world.addObstacle(box("against_the_block", 0.4, 0.4, Pose2D{6.9, 1.0, 0.0}));
+  EXPECT_EQ(world.obstacles().size(), 3u);
+  world.resetPositions();  // moves robots and movers only
+  EXPECT_EQ(world.obstacles().size(), 3u);
+}
+
+TEST(Requests, ObstacleRequestShapesAsTheWorldFileReaderWordsThem)
+{
+  const Pose2D pose{3.0, 2.0, 0.5};
+  const ObstacleConfig b = obstacleFromRequest("crate", "box", 0.5, 0.4, 0.0, pose);
+  EXPECT_EQ(b.name, "crate");
+  EXPECT_EQ(b.shape.type, ShapeConfig::Type::BOX);
+  EXPECT_DOUBLE_EQ(b.shape.length, 0.5);
+  EXPECT_DOUBLE_EQ(b.shape.width, 0.4);
+  EXPECT_DOUBLE_EQ(b.pose.yaw, 0.5);
+  const ObstacleConfig c = obstacleFromRequest("drum", "cylinder", 0.0, 0.0, 0.3, pose);
+  EXPECT_EQ(c.shape.type, ShapeConfig::Type::CYLINDER);
+  EXPECT_DOUBLE_EQ(c.shape.radius, 0.3);
+
+  EXPECT_EQ(errorOf([&] { obstacleFromRequest("t", "triangle", 0.5, 0.5, 0.0, pose); }),
+            "obstacle t: shape: expected box or cylinder, got \"triangle\"");
+  EXPECT_EQ(errorOf([&] { obstacleFromRequest("t", "", 0.5, 0.5, 0.0, pose); }),
+            "obstacle t: shape: expected box or cylinder, got \"\"");
+  EXPECT_EQ(errorOf([&] { obstacleFromRequest("t", "Box", 0.5, 0.5, 0.0, pose); }),
+            "obstacle t: shape: expected box or cylinder, got \"Box\"");
+  EXPECT_EQ(errorOf([&] { obstacleFromRequest("t", "box", 0.5, 0.5, 0.2, pose); }),
+            "obstacle t: radius: a box has a size [length, width], not a radius");
+  EXPECT_EQ(errorOf([&] { obstacleFromRequest("t", "cylinder", 0.5, 0.0, 0.2, pose); }),
+            "obstacle t: length, width: a cylinder has a radius, not a size");
+}
+
 TEST(Requests, ResetPutsRobotsBackAndZeroesOdometry)
 {
   World world(roomMap(), WorldSettings{});

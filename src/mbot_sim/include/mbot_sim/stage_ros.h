@@ -11,8 +11,10 @@
 #include <geometry_msgs/Pose2D.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <mbot_msgs/RemoveObstacle.h>
 #include <mbot_msgs/RemoveRobot.h>
 #include <mbot_msgs/SetFault.h>
+#include <mbot_msgs/SpawnObstacle.h>
 #include <mbot_msgs/SpawnRobot.h>
 #include <mbot_msgs/TeleportRobot.h>
 #include <nav_msgs/Odometry.h>
@@ -125,6 +127,8 @@ private:
   bool onUnpause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onSpawn(mbot_msgs::SpawnRobot::Request& req, mbot_msgs::SpawnRobot::Response& res);
   bool onRemove(mbot_msgs::RemoveRobot::Request& req, mbot_msgs::RemoveRobot::Response& res);
+  bool onSpawnObstacle(mbot_msgs::SpawnObstacle::Request& req, mbot_msgs::SpawnObstacle::Response& res);
+  bool onRemoveObstacle(mbot_msgs::RemoveObstacle::Request& req, mbot_msgs::RemoveObstacle::Response& res);
   bool onTeleport(mbot_msgs::TeleportRobot::Request& req, mbot_msgs::TeleportRobot::Response& res);
   bool onSetFault(mbot_msgs::SetFault::Request& req, mbot_msgs::SetFault::Response& res);
 

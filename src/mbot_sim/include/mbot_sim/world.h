@@ -147,8 +147,15 @@ public:
   int addRobot(const std::string& name, const mbot_description::RobotModel& model, const Pose2D& pose);
   /// @throws SimError: unknown robot
   void removeRobot(const std::string& name);
-  /// @throws SimError: duplicate name, overlapping a robot
+  /// @brief Add a static box or cylinder, at start or at run time: the laser sees it from the
+  ///        next scan on, robots collide with it from the next step on (contacts name it).
+  ///        It may touch walls and other obstacles, but no robot.
+  /// @throws SimError: duplicate or invalid name, a size <= 0 or NaN, a pose that is not
+  ///         finite, a centre outside the map, overlapping a robot
   void addObstacle(const ObstacleConfig& obstacle);
+  /// @brief Remove a static obstacle (from the world file or added later); its name is free again.
+  /// @throws SimError: unknown obstacle, or the name of a robot, a moving obstacle or the walls
+  void removeObstacle(const std::string& name);
   /// @throws SimError: duplicate name, fewer than 2 waypoints, speed <= 0
   void addMovingObstacle(const MovingObstacleConfig& obstacle);
 
@@ -200,6 +207,13 @@ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// @brief The obstacle a run-time request describes (the fields of mbot_msgs/SpawnObstacle):
+///        shape "box" with length and width, or "cylinder" with radius; the other shape's
+///        sizes must be 0. World::addObstacle() checks the rest (name, sizes > 0, pose).
+/// @throws SimError: a shape other than box or cylinder, a size of the other shape given
+ObstacleConfig obstacleFromRequest(const std::string& name, const std::string& shape, double length, double width,
+                                   double radius, const Pose2D& pose);
 
 /// @brief Loads a robot model by name (e.g. with mbot_description::loadRobotModel).
 using ModelLoader = std::function<mbot_description::RobotModel(const std::string& model)>;
