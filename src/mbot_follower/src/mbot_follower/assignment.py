@@ -1,0 +1,60 @@
+"""Which robot takes which slot: the least total travel, the leader always in slot 0.
+
+When a formation is formed or switched, every follower may take any follower slot. Giving each
+robot the slot nearest to it one by one can send two robots across each other; the optimal
+assignment (the Hungarian method, `scipy.optimize.linear_sum_assignment`) minimises the sum of
+straight-line distances instead. The leader does not move to a slot: slot 0 is wherever it is.
+Pure numpy/scipy, no ROS.
+"""
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+
+def _as_points(name, value):
+    points = np.asarray(value, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 2:
+        raise ValueError("%s: expected an (n, 2) array of [x, y], got shape %s"
+                         % (name, points.shape))
+    if not np.all(np.isfinite(points)):
+        raise ValueError("%s: every coordinate must be finite, got %s" % (name, points.tolist()))
+    return points
+
+
+def assign_slots(positions, slot_positions, leader_index=0):
+    """Return `slot_of`, a list where slot_of[i] is the slot index of robot i.
+
+    positions: (n, 2) world positions of the robots [m]; slot_positions: (n, 2) world positions
+    of the slots [m], slot 0 = the leader's slot. Robot `leader_index` gets slot 0; the other
+    robots get slots 1..n-1 so that the sum of Euclidean distances robot -> slot is smallest.
+    """
+    robots = _as_points("positions", positions)
+    slots = _as_points("slot_positions", slot_positions)
+    n = len(robots)
+    if len(slots) != n:
+        raise ValueError("assign_slots: %d robots but %d slots (one slot per robot)"
+                         % (n, len(slots)))
+    if n == 0:
+        raise ValueError("assign_slots: no robots")
+    if isinstance(leader_index, bool) or not isinstance(leader_index, (int, np.integer)) \
+            or not 0 <= leader_index < n:
+        raise ValueError("assign_slots: leader_index must be a robot index in [0, %d], got %r"
+                         % (n - 1, leader_index))
+
+    slot_of = [0] * n
+    followers = [i for i in range(n) if i != leader_index]
+    if followers:
+        # cost[a, b]: distance of follower a to follower slot b + 1
+        diff = robots[followers][:, None, :] - slots[1:][None, :, :]
+        cost = np.hypot(diff[:, :, 0], diff[:, :, 1])
+        rows, cols = linear_sum_assignment(cost)
+        for a, b in zip(rows, cols):
+            slot_of[followers[a]] = int(b) + 1
+    return slot_of
+
+
+def total_travel(positions, slot_positions, slot_of):
+    """Sum of the distances [m] from each robot to its slot (the leader's term is its distance to
+    slot 0, which is 0 when slot 0 is placed on the leader)."""
+    robots = _as_points("positions", positions)
+    slots = _as_points("slot_positions", slot_positions)
+    return float(sum(np.hypot(*(slots[s] - robots[i])) for i, s in enumerate(slot_of)))

@@ -1,0 +1,66 @@
+"""Slot assignment: the leader keeps slot 0, the followers travel least in total (= brute force)."""
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from mbot_follower.assignment import assign_slots, total_travel
+
+
+def brute_force(positions, slots, leader):
+    """The least total travel over every permutation of the follower slots, and its assignment."""
+    followers = [i for i in range(len(positions)) if i != leader]
+    best, best_slot_of = math.inf, None
+    for perm in itertools.permutations(range(1, len(slots))):
+        slot_of = [0] * len(positions)
+        for robot, slot in zip(followers, perm):
+            slot_of[robot] = slot
+        cost = total_travel(positions, slots, slot_of)
+        if cost < best:
+            best, best_slot_of = cost, slot_of
+    return best, best_slot_of
+
+
+@pytest.mark.parametrize("n", range(1, 8))
+def test_equals_brute_force_on_random_cases(n):
+    rng = np.random.RandomState(100 + n)
+    for case in range(20 if n < 7 else 5):
+        positions = rng.uniform(-5, 5, size=(n, 2))
+        slots = rng.uniform(-5, 5, size=(n, 2))
+        leader = int(rng.randint(n))
+        slots[0] = positions[leader]            # slot 0 sits on the leader
+        slot_of = assign_slots(positions, slots, leader_index=leader)
+        assert sorted(slot_of) == list(range(n))
+        assert slot_of[leader] == 0
+        best, best_slot_of = brute_force(positions, slots, leader)
+        assert total_travel(positions, slots, slot_of) == pytest.approx(best, abs=1e-9)
+        assert slot_of == best_slot_of          # random reals: the optimum is unique
+
+
+def test_crossing_paths_are_untangled():
+    # greedy (robot 1 first takes its nearest slot) would send robot 2 the long way round
+    positions = [[0, 0], [-1, 0.2], [-1, -0.2]]
+    slots = [[0, 0], [-1.0, 1.0], [-1.0, -0.1]]
+    assert assign_slots(positions, slots) == [0, 1, 2]
+    assert total_travel(positions, slots, [0, 1, 2]) == pytest.approx(0.8 + 0.1)
+
+
+def test_the_leader_keeps_slot_0_even_when_a_follower_is_nearer():
+    positions = [[5.0, 5.0], [0.1, 0.0], [-1.0, 0.0]]   # robot 1 sits on slot 0, robot 0 leads
+    slots = [[0.0, 0.0], [-1.0, 0.0], [-2.0, 0.0]]
+    assert assign_slots(positions, slots, leader_index=0) == [0, 1, 2]
+    assert assign_slots(positions, slots, leader_index=2)[2] == 0
+
+
+@pytest.mark.parametrize("positions,slots,leader,says", [
+    ([[0, 0], [1, 1]], [[0, 0]], 0, "2 robots but 1 slots"),
+    ([[0, 0, 0]], [[0, 0, 0]], 0, "positions: expected an (n, 2) array"),
+    ([[0, 0], [1, float("nan")]], [[0, 0], [1, 1]], 0, "positions: every coordinate must be finite"),
+    ([[0, 0], [1, 1]], [[0, 0], [1, 1]], 2, "leader_index must be a robot index in [0, 1], got 2"),
+    ([[0, 0], [1, 1]], [[0, 0], [1, 1]], True, "leader_index must be a robot index"),
+])
+def test_bad_input_is_named(positions, slots, leader, says):
+    with pytest.raises(ValueError) as e:
+        assign_slots(positions, slots, leader_index=leader)
+    assert says in str(e.value)
