@@ -104,12 +104,13 @@ def read_world(path):
 
 
 def fleet_launch_xml(world, localization="fake", base_global_planner="astar", config_dir="", output="log",
-                     robots=None):
+                     robots=None, extra_lines=()):
     """The text of a launch file that starts the map server (the world's map) and, per robot,
     navigation.launch (localization + nav node).
 
     :param world: a World (read_world())
     :param robots: names of the robots to include (default: all of the world's)
+    :param extra_lines: more launch XML lines to put inside <launch> (other packages' nodes)
     """
     if localization not in LOCALIZATIONS:
         raise ValueError("localization: expected one of %s, got %r" % (", ".join(LOCALIZATIONS), localization))
@@ -130,6 +131,7 @@ def fleet_launch_xml(world, localization="fake", base_global_planner="astar", co
         lines.append('  <include file="$(find mbot_navigation)/launch/navigation.launch">')
         lines += ["    <arg name=%s value=%s/>" % (quoteattr(k), quoteattr(v)) for k, v in args]
         lines.append("  </include>")
+    lines += list(extra_lines)
     lines.append("</launch>")
     return "\n".join(lines) + "\n"
 
@@ -151,11 +153,8 @@ def parse_args(argv):
 def main(argv=None):
     """Node ``fleet_navigation``. It uses no rospy (a rospy node would process every /clock
     message, thousands per second at a high real-time factor): only roslaunch's API."""
-    import signal
     import sys
-    import time
 
-    import roslaunch
     import rospkg
 
     args = parse_args(sys.argv[1:] if argv is None else argv)
@@ -167,11 +166,24 @@ def main(argv=None):
         print("fleet_navigation: %s" % error, file=sys.stderr)
         return 1
 
-    handle, path = tempfile.mkstemp(prefix="fleet_navigation_", suffix=".launch")
-    with os.fdopen(handle, "w") as f:
-        f.write(text)
     print("fleet_navigation: %d robots of %s (%s localization): %s" % (
         len(world.robots), world.path, args.localization, ", ".join(r.name for r in world.robots)))
+    return run_launch_text(text, "fleet_navigation")
+
+
+def run_launch_text(text, name):
+    """Run the launch file `text` with roslaunch's API inside this process until this process is
+    told to stop (SIGINT/SIGTERM: 0) or a required node of it exits (1). Its processes stop with
+    it. `name` prefixes the temporary file and the messages."""
+    import signal
+    import sys
+    import time
+
+    import roslaunch
+
+    handle, path = tempfile.mkstemp(prefix=name + "_", suffix=".launch")
+    with os.fdopen(handle, "w") as f:
+        f.write(text)
     stop_requested = []
 
     def on_signal(signum, _frame):
@@ -188,7 +200,7 @@ def main(argv=None):
         while not parent.pm.is_shutdown and not stop_requested:
             time.sleep(0.2)  # wall time
         if not stop_requested:
-            print("fleet_navigation: a required node of the fleet exited; stopping", file=sys.stderr)
+            print("%s: a required node exited; stopping" % name, file=sys.stderr)
             status = 1
     finally:
         parent.shutdown()

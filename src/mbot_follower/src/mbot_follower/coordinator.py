@@ -1,0 +1,360 @@
+"""The fleet coordinator's state machine, without ROS (the node is coordinator_node.py).
+
+States (``FleetStatus``)::
+
+    IDLE --goal--> FORMING --shape reached--> NAVIGATING --leader at goal, shape stable--> ARRIVED
+                      ^                            |
+                      +------- new goal -----------+--- leader's navigation gives up --> ABORTED
+
+    DEGRADED: a member is lost (no pose or, for a follower, no controller for ``loss_timeout``).
+    The slots are re-planned for the robots left and the goal is kept: the fleet goes on forming
+    or navigating, and the state reads DEGRADED until the lost robot comes back (it rejoins a
+    slot) or the fleet arrives. A lost leader is replaced by the follower nearest its slot, which
+    takes over the leader's navigation goal.
+
+A goal that cannot be reached as given (a NaN, off the map, in a wall) or an unknown formation
+is refused at once: the state does not change and the message says why.
+
+The node calls ``update()`` every cycle with what it sees (poses, when each robot was last
+heard, the leader's navigation state, an obstacle in front of the leader) and carries out the
+actions it returns: ``("goal", robot, Pose2D)`` send the leader its navigation goal,
+``("cancel", robot)`` cancel it, ``("assignment",)`` publish the new slot assignment.
+"""
+import math
+
+import numpy as np
+
+from mbot_common.geometry import Pose2D, compose, normalize_angle
+from mbot_follower.assignment import assign_slots
+from mbot_follower.fleet_io import Assignment
+from mbot_follower.formations import FormationError, FormationLibrary
+from mbot_follower.shape import shape_errors
+
+IDLE, FORMING, NAVIGATING, ARRIVED, DEGRADED, ABORTED = (
+    "IDLE", "FORMING", "NAVIGATING", "ARRIVED", "DEGRADED", "ABORTED")
+#: When the robots left cannot take the formation (a diamond of 3), the first of these that fits.
+FALLBACK_FORMATIONS = ("triangle", "wedge", "column")
+
+
+class CoordinatorConfig(object):
+    """Thresholds and times of the coordinator (sim time)."""
+
+    def __init__(self):
+        self.form_edge_tolerance = 0.3             # FORMING ends below this edge-length error [m]
+        self.form_heading_tolerance = math.radians(5.0)  # ... and this follower heading error [rad]
+        self.stable_time = 0.5                     # the shape must hold this long [s]
+        self.forming_timeout = 60.0                # then navigate anyway, saying who is off [s]
+        self.arrive_timeout = 30.0                 # leader at goal: ARRIVED after this at the latest [s]
+        self.loss_timeout = 1.0                    # unheard this long = lost [s]
+        self.pause_time = 1.0                      # obstacle in front of the leader: all stop this long [s]
+        self.pause_cooldown = 5.0                  # no new pause this soon after one ends [s]
+        self.topology = "star"                     # who follows whom: star or chain
+
+
+def check_target(target, free_space=None):
+    """None when the leader can be sent to `target`, else why not (one line)."""
+    values = (target.x, target.y, target.theta)
+    if not all(math.isfinite(v) for v in values):
+        return "target (%s, %s, %s) is not a finite pose" % values
+    if free_space is not None:
+        if free_space.cell(target.x, target.y) is None:
+            return "target (%.2f, %.2f) is off the map" % (target.x, target.y)
+        if not free_space.is_free(target.x, target.y):
+            return "target (%.2f, %.2f) is in a wall or too close to one for a robot" % (target.x, target.y)
+    return None
+
+
+class FleetCoordinator(object):
+    """The fleet's state, formation and slot assignment; see the module docstring."""
+
+    def __init__(self, robots, leader, formation, spacing, config=None, library=None, free_space=None):
+        self.config = config or CoordinatorConfig()
+        self.library = library or FormationLibrary()
+        self.free_space = free_space
+        if leader not in robots:
+            raise ValueError("leader %r is not one of the robots (%s)" % (leader, ", ".join(robots)))
+        self.robots = list(robots)
+        self.leader = leader
+        self.members = list(robots)          # in the formation now
+        self.lost = []                       # lost and not back
+        self.formation = formation
+        self.spacing = float(spacing)
+        self.library.make(formation, len(self.members), self.spacing, topology=self.config.topology)  # validates
+        self.phase = IDLE                    # what the fleet is doing; state() adds DEGRADED
+        self.reason = "waiting for a target"
+        self.target = None
+        self.paused = False
+        self.assignment = None
+        self.errors = None                   # ShapeErrors of the last update
+        self.events = []                     # (time, kind, text): switches, losses, rejoins, pauses
+        self._stable_since = None
+        self._phase_since = 0.0
+        self._leader_done_at = None
+        self._pause_until = None
+        self._no_pause_before = -1e9
+        self._switch_started = None
+        self._lost_at = {}
+        self._last_leader_pose = None        # where the leader was last seen (for a replacement)
+
+    # --- what the outside sees ----------------------------------------------------------------
+
+    def state(self):
+        if self.lost and self.phase not in (ARRIVED, ABORTED):
+            return DEGRADED
+        return self.phase
+
+    # --- commands -----------------------------------------------------------------------------
+
+    def set_goal(self, target, now, poses, formation="", spacing=0.0):
+        """Start driving the formation to `target` (Pose2D, map). Returns (accepted, message,
+        actions). A refused goal changes nothing."""
+        problem = check_target(target, self.free_space)
+        if problem is None and (formation or spacing):
+            problem = self._formation_problem(formation or self.formation, spacing or self.spacing)
+        if problem is not None:
+            self.reason = "goal refused: " + problem
+            return False, problem, []
+        actions = []
+        if self.phase == NAVIGATING:
+            actions.append(("cancel", self.leader))
+        self.formation = formation or self.formation
+        self.spacing = spacing or self.spacing
+        self.target = target
+        self.paused = False
+        self._pause_until = None
+        self._set_phase(FORMING, now, "forming %s for the target (%.2f, %.2f)" % (self.formation, target.x, target.y))
+        actions += self._reassign(poses, now)
+        return True, "accepted", actions
+
+    def cancel_goal(self, now, reason):
+        """Give up the current goal: the leader stops and the fleet waits (IDLE)."""
+        actions = [("cancel", self.leader)] if self.phase == NAVIGATING else []
+        self.target = None
+        self.paused = False
+        self._set_phase(IDLE, now, reason)
+        return actions
+
+    def set_formation(self, name, now, poses, spacing=0.0):
+        """Switch the formation now, moving or not. Returns (accepted, message, actions)."""
+        spacing = spacing or self.spacing
+        problem = self._formation_problem(name, spacing)
+        if problem is not None:
+            self.reason = "formation switch refused: " + problem
+            return False, problem, []
+        self.formation, self.spacing = name, spacing
+        self._switch_started = now
+        self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
+        self.reason = "switching to %s" % name
+        return True, "switching to %s (%d robots, spacing %.2f m)" % (name, len(self.members), spacing), \
+            self._reassign(poses, now)
+
+    def _formation_problem(self, name, spacing):
+        try:
+            self.library.make(name, len(self.members), spacing, topology=self.config.topology)
+        except (FormationError, ValueError) as error:
+            return str(error)
+        return None
+
+    # --- the cycle ----------------------------------------------------------------------------
+
+    def update(self, now, poses, last_heard, leader_nav=None, obstacle_ahead=False):
+        """One coordinator cycle.
+
+        :param now: sim time [s]
+        :param poses: {robot: Pose2D in the map} of the robots with a current pose
+        :param last_heard: {robot: sim time [s] it was last complete (pose, and controller for a follower)}
+        :param leader_nav: the leader's navigation: None (no goal), "ACTIVE", "SUCCEEDED" or
+            "ABORTED: <why>"
+        :param obstacle_ahead: something is close in front of the leader
+        :returns: list of actions (module docstring)
+        """
+        actions = self._losses_and_rejoins(now, poses, last_heard)
+        if self.assignment is None and all(r in poses for r in self.members):
+            actions += self._reassign(poses, now)
+        self.errors = self._shape_errors(poses)
+        stable = self._stable(now)
+        if self._switch_started is not None and stable:
+            self.events.append((now, "switched", "%s reached in %.1f s" % (self.formation, now - self._switch_started)))
+            self._switch_started = None
+
+        if self.phase == FORMING:
+            timed_out = now - self._phase_since > self.config.forming_timeout
+            if stable or timed_out:
+                why = "formation reached" if stable else "formation not reached in %.0f s (%s); navigating anyway" % (
+                    self.config.forming_timeout, self._worst_follower(poses))
+                self._set_phase(NAVIGATING, now, why)
+                self._leader_done_at = None
+                actions.append(("goal", self.leader, self.target))
+        elif self.phase == NAVIGATING:
+            actions += self._navigating(now, poses, leader_nav, obstacle_ahead, stable)
+        return actions
+
+    def _navigating(self, now, poses, leader_nav, obstacle_ahead, stable):
+        actions = []
+        if self.paused:
+            if now >= self._pause_until:
+                self.paused = False
+                self._no_pause_before = now + self.config.pause_cooldown
+                self.reason = "resuming: the leader's navigation goes around the obstacle"
+                self.events.append((now, "resume", self.reason))
+                actions.append(("goal", self.leader, self.target))
+            return actions
+        if obstacle_ahead and now >= self._no_pause_before and self._leader_done_at is None:
+            self.paused = True
+            self._pause_until = now + self.config.pause_time
+            self.reason = "paused: obstacle in front of the leader %s" % self.leader
+            self.events.append((now, "pause", self.reason))
+            return [("cancel", self.leader)]
+        if leader_nav is not None and leader_nav.startswith("ABORTED"):
+            self._set_phase(ABORTED, now, "the leader's navigation gave up: %s" % leader_nav[len("ABORTED"):].lstrip(": "))
+            return actions
+        if leader_nav == "SUCCEEDED" and self._leader_done_at is None:
+            self._leader_done_at = now
+        if self._leader_done_at is not None:
+            if stable:
+                self._set_phase(ARRIVED, now, "the leader is at the target and the formation is stable")
+            elif now - self._leader_done_at > self.config.arrive_timeout:
+                self._set_phase(ARRIVED, now, "the leader is at the target; formation not stable after %.0f s (%s)" % (
+                    self.config.arrive_timeout, self._worst_follower(poses)))
+        return actions
+
+    # --- losses -------------------------------------------------------------------------------
+
+    def _losses_and_rejoins(self, now, poses, last_heard):
+        actions = []
+        newly_lost = [r for r in self.members
+                      if now - last_heard.get(r, -1e9) > self.config.loss_timeout and self.assignment is not None]
+        back = [r for r in self.lost if now - last_heard.get(r, -1e9) <= self.config.loss_timeout and r in poses]
+        if not newly_lost and not back:
+            return actions
+        old_leader = self.leader
+        for r in newly_lost:
+            self.members.remove(r)
+            self.lost.append(r)
+            self._lost_at[r] = now
+            self.events.append((now, "lost", r))
+        for r in back:
+            self.lost.remove(r)
+            self.members.append(r)
+            self.events.append((now, "rejoined", "%s after %.1f s" % (r, now - self._lost_at.pop(r, now))))
+        if not self.members:
+            self._set_phase(ABORTED, now, "every robot of the fleet is lost")
+            self.assignment = None
+            return actions
+        if old_leader in newly_lost:
+            self.leader = self._nearest_to_leader_slot(poses)
+            if self.phase == NAVIGATING and not self.paused:
+                actions.append(("goal", self.leader, self.target))
+        words = []
+        if newly_lost:
+            words.append("lost %s" % ", ".join(newly_lost))
+        if back:
+            words.append("%s rejoined" % ", ".join(back))
+        if self.leader != old_leader:
+            words.append("%s leads now" % self.leader)
+        if self._formation_problem(self.formation, self.spacing) is not None:
+            for name in FALLBACK_FORMATIONS:
+                if self._formation_problem(name, self.spacing) is None:
+                    words.append("%s does not fit %d robots: %s" % (self.formation, len(self.members), name))
+                    self.formation = name
+                    break
+        self.reason = "; ".join(words)
+        actions += self._reassign(poses, now)
+        return actions
+
+    def _nearest_to_leader_slot(self, poses):
+        """The member nearest to where the leader was (its slot), among those with a pose."""
+        ref = self._last_leader_pose
+        candidates = [r for r in self.members if r in poses]
+        if not candidates:
+            return self.members[0]
+        if ref is None:
+            return candidates[0]
+        return min(candidates, key=lambda r: math.hypot(poses[r].x - ref.x, poses[r].y - ref.y))
+
+    # --- slots and shape ----------------------------------------------------------------------
+
+    def _reassign(self, poses, now):
+        """Give every member a slot: the leader keeps slot 0, the others by least total travel.
+        Needs every member's pose; without them the assignment waits for the next cycle."""
+        if not all(r in poses for r in self.members):
+            self.assignment = None
+            return []
+        formation = self.library.make(self.formation, len(self.members), self.spacing, topology=self.config.topology)
+        order = [self.leader] + [r for r in self.members if r != self.leader]
+        leader_pose = poses[self.leader]
+        slot_world = np.array([_apply(leader_pose, o) for o in formation.offsets])
+        positions = np.array([[poses[r].x, poses[r].y] for r in order])
+        slot_of = assign_slots(positions, slot_world, leader_index=0)
+        robot_in_slot = {slot_of[i]: r for i, r in enumerate(order)}
+        slots = {r: (float(formation.offsets[slot_of[i]][0]), float(formation.offsets[slot_of[i]][1]))
+                 for i, r in enumerate(order)}
+        follows = {}
+        for i, r in enumerate(order):
+            parent = formation.parents[slot_of[i]]
+            follows[r] = robot_in_slot[parent] if parent >= 0 else ""
+        self.assignment = Assignment(self.leader, self.formation, self.spacing, slots, follows)
+        self._stable_since = None
+        return [("assignment",)]
+
+    def _shape_errors(self, poses):
+        a = self.assignment
+        if a is None or a.leader not in poses:
+            return None
+        self._last_leader_pose = poses[a.leader]
+        robots = [a.leader] + [r for r in a.slots if r != a.leader and r in poses]
+        if len(robots) < 2:
+            return None
+        leader = poses[a.leader]
+        actual = np.array([[poses[r].x, poses[r].y] for r in robots])
+        desired = np.array([_apply(leader, a.slots[r]) for r in robots])
+        headings = [poses[r].theta for r in robots]
+        return shape_errors(actual, desired, headings=headings, leader_heading=leader.theta)
+
+    def _stable(self, now):
+        """The shape is within the FORMING tolerances and has been for stable_time."""
+        e = self.errors
+        ok = e is not None and e.edge_max < self.config.form_edge_tolerance and \
+            e.heading_max < self.config.form_heading_tolerance
+        if len(self.members) == 1 and self.assignment is not None:
+            ok = True
+        if not ok:
+            self._stable_since = None
+            return False
+        if self._stable_since is None:
+            self._stable_since = now
+        return now - self._stable_since >= self.config.stable_time
+
+    def slot_errors(self, poses):
+        """{follower: (distance to its slot [m], heading error [rad])} for the debug print."""
+        a = self.assignment
+        if a is None or a.leader not in poses:
+            return {}
+        leader = poses[a.leader]
+        result = {}
+        for r, offset in sorted(a.slots.items()):
+            if r == a.leader or r not in poses:
+                continue
+            x, y = _apply(leader, offset)
+            result[r] = (math.hypot(poses[r].x - x, poses[r].y - y), normalize_angle(poses[r].theta - leader.theta))
+        return result
+
+    def _worst_follower(self, poses):
+        errors = self.slot_errors(poses)
+        if not errors:
+            return "no follower pose"
+        r = max(errors, key=lambda k: errors[k][0])
+        return "%s is %.2f m from its slot" % (r, errors[r][0])
+
+    def _set_phase(self, phase, now, reason):
+        if phase != self.phase:
+            self.events.append((now, "state", "%s -> %s" % (self.phase, phase)))
+        self.phase = phase
+        self._phase_since = now
+        self.reason = reason
+
+
+def _apply(pose, offset):
+    """A slot offset (x, y) in the frame of `pose` -> map (x, y)."""
+    p = compose(pose, Pose2D(offset[0], offset[1], 0.0))
+    return p.x, p.y

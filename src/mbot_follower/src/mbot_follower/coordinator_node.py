@@ -1,0 +1,363 @@
+"""Node ``coordinator``: the ROS side of the fleet coordinator (the logic is coordinator.py).
+
+Inputs: ``/fleet/target_pose`` and ``/simulation/target_pose`` (geometry_msgs/Pose2D), the action
+``/fleet/goal`` (mbot_msgs/FleetGoal), ``/fleet/formation`` (std_msgs/String) and the service
+``/fleet/set_formation`` (mbot_msgs/SetFormation); each robot's pose from tf2 (``map ->
+<robot>/base_link``), each follower controller's ``~state`` (its heartbeat), the leader's scan
+(the fleet pauses when something is closer than ``~pause_distance`` in front of it) and ``/map``
+(targets in walls or off the map are refused).
+
+Outputs: ``/fleet/status`` (FleetStatus, on every change and at 2 Hz), ``/fleet/assignment``
+(latched), ``/fleet/markers`` (slots, links, labels, state, a red marker while paused) and the
+leader's move_base goal. ``~debug_mode`` prints every follower's slot error in cm and degrees.
+"""
+import math
+import threading
+import time
+
+import rospy
+
+from mbot_common.geometry import Pose2D
+from mbot_follower.control_laws import safety_stop
+from mbot_follower.coordinator import ABORTED, ARRIVED, CoordinatorConfig, FleetCoordinator
+from mbot_follower.fleet_io import StalePose, assignment_to_msg, lookup_pose
+from mbot_follower.formations import FormationLibrary
+from mbot_follower.free_space import FreeSpace
+from mbot_follower import markers
+
+NODE_PARAMS = {
+    "rate": 10.0,              # coordinator cycle [Hz sim time]
+    "max_pose_age": 0.5,       # a robot's pose older than this does not count as seen [s]
+    "pause_distance": 1.2,     # obstacle this close in front of the leader pauses the fleet [m]
+    "pause_half_angle": math.radians(30.0),  # half-width of "in front" [rad]
+    "map_clearance": 0.2,      # a target closer than this to a wall is refused [m]
+    "debug_mode": False,       # print every follower's slot error once per second
+    "startup_timeout": 60.0,   # [s wall] wait this long for every robot before counting absent ones lost
+}
+
+
+def _robots_from_params():
+    """The fleet's robots: ~robots if given, else the robots of the world file ~world."""
+    robots = rospy.get_param("~robots", [])
+    if robots:
+        return [str(r) for r in robots]
+    world = rospy.get_param("~world", "")
+    if not world:
+        raise ValueError("set ~robots (a list of names) or ~world (a world name or file)")
+    import rospkg
+    from mbot_navigation.fleet_launch import find_maps_directory, read_world, resolve_world_path
+
+    maps = find_maps_directory(rospkg.RosPack().get_path("mbot_follower"))
+    return [r.name for r in read_world(resolve_world_path(world, maps)).robots]
+
+
+class CoordinatorNode(object):
+    def __init__(self):
+        import actionlib
+        import tf2_ros
+        from geometry_msgs.msg import Pose2D as Pose2DMsg
+        from mbot_msgs.msg import FleetAssignment, FleetGoalAction, FleetStatus, FollowerState
+        from mbot_msgs.srv import SetFormation
+        from nav_msgs.msg import OccupancyGrid
+        from std_msgs.msg import String
+        from visualization_msgs.msg import MarkerArray
+
+        self._FleetStatus = FleetStatus
+        self.params = {k: type(v)(rospy.get_param("~" + k, v)) for k, v in NODE_PARAMS.items()}
+        self.robots = _robots_from_params()
+        leader = rospy.get_param("~leader", "") or self.robots[0]
+        config = CoordinatorConfig()
+        for key in vars(config):
+            if rospy.has_param("~" + key):
+                setattr(config, key, type(getattr(config, key))(rospy.get_param("~" + key)))
+        library = FormationLibrary()
+        formation_file = rospy.get_param("~formation_file", "")
+        if formation_file:
+            library.load_file(formation_file)
+        self.core = FleetCoordinator(self.robots, leader, rospy.get_param("~formation", "triangle"),
+                                     rospy.get_param("~spacing", 2.5), config, library)
+        self.lock = threading.RLock()
+        self.last_heard_pose = {}
+        self.last_heard_controller = {}
+        self.poses = {}
+        self.leader_scan = None
+        self._scan_sub = None
+        self._scan_robot = None
+        self._nav_robot = None       # whose move_base has our goal
+        self._published_state = None
+        self._last_status = None
+        self._last_debug = None
+        self._startup_done = False
+        self._wall_start = time.time()
+
+        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
+        self._tf_listener = tf2_ros.TransformListener(self.tf_buffer)
+        self.status_pub = rospy.Publisher("/fleet/status", FleetStatus, queue_size=10)
+        self.assignment_pub = rospy.Publisher("/fleet/assignment", FleetAssignment, queue_size=1, latch=True)
+        self.marker_pub = rospy.Publisher("/fleet/markers", MarkerArray, queue_size=1)
+        for topic in ("/fleet/target_pose", "/simulation/target_pose"):
+            rospy.Subscriber(topic, Pose2DMsg, self._on_target_pose, queue_size=1)
+        rospy.Subscriber("/fleet/formation", String, self._on_formation, queue_size=1)
+        rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
+        for robot in self.robots:
+            rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self._on_controller,
+                             callback_args=robot, queue_size=1)
+        self.formation_srv = rospy.Service("/fleet/set_formation", SetFormation, self._on_set_formation)
+        self.action = actionlib.SimpleActionServer("/fleet/goal", FleetGoalAction, execute_cb=self._execute,
+                                                   auto_start=False)
+        self.action.start()
+        from move_base_msgs.msg import MoveBaseAction
+
+        self._nav_clients = {r: actionlib.SimpleActionClient("/%s/move_base" % r, MoveBaseAction) for r in self.robots}
+        self._nav_connected = set()
+        self._connect_nav_thread = threading.Thread(target=self._connect_nav, daemon=True)
+        self._connect_nav_thread.start()
+        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), self._cycle)
+        rospy.loginfo("coordinator: robots %s, leader %s, formation %s (spacing %.2f m)", ", ".join(self.robots),
+                      leader, self.core.formation, self.core.spacing)
+
+    # --- commands -----------------------------------------------------------------------------
+
+    def _on_target_pose(self, msg):
+        ok, text = self._set_goal(Pose2D(msg.x, msg.y, msg.theta))
+        (rospy.loginfo if ok else rospy.logerr)("coordinator: target (%.2f, %.2f, %.2f): %s", msg.x, msg.y,
+                                                msg.theta, text)
+
+    def _set_goal(self, target, formation="", spacing=0.0):
+        with self.lock:
+            now = rospy.Time.now().to_sec()
+            ok, text, actions = self.core.set_goal(target, now, dict(self.poses), formation, spacing)
+            self._run(actions)
+            self._publish_status(force=True)
+        return ok, text
+
+    def _on_formation(self, msg):
+        ok, text = self._switch(msg.data, 0.0)
+        (rospy.loginfo if ok else rospy.logerr)("coordinator: formation %r: %s", msg.data, text)
+
+    def _on_set_formation(self, req):
+        from mbot_msgs.srv import SetFormationResponse
+
+        ok, text = self._switch(req.formation, req.spacing)
+        return SetFormationResponse(ok, text)
+
+    def _switch(self, name, spacing):
+        if not (spacing == 0.0 or (math.isfinite(spacing) and spacing > 0.0)):
+            return False, "spacing %r: expected a number > 0 [m] (0 keeps the current one)" % spacing
+        with self.lock:
+            ok, text, actions = self.core.set_formation(name.strip(), rospy.Time.now().to_sec(), dict(self.poses),
+                                                        spacing)
+            self._run(actions)
+            self._publish_status(force=True)
+        return ok, text
+
+    def _execute(self, goal):
+        """/fleet/goal: accept from the action server's own thread (as move_base does), then
+        report until the fleet arrives, aborts or the goal is preempted."""
+        from mbot_msgs.msg import FleetGoalFeedback, FleetGoalResult
+
+        start = rospy.Time.now()
+        t = goal.target
+        ok, text = self._set_goal(Pose2D(t.x, t.y, t.theta), goal.formation, goal.spacing)
+        result = FleetGoalResult()
+        if not ok:
+            result.success, result.message = False, text
+            self.action.set_aborted(result, text)
+            return
+        rate = rospy.Rate(5.0)
+        while not rospy.is_shutdown():
+            if self.action.is_preempt_requested():
+                with self.lock:
+                    self._run(self.core.cancel_goal(rospy.Time.now().to_sec(), "goal preempted"))
+                result.success, result.message = False, "preempted"
+                result.duration = (rospy.Time.now() - start).to_sec()
+                self.action.set_preempted(result, "preempted")
+                return
+            with self.lock:
+                state, reason, errors = self.core.state(), self.core.reason, self.core.errors
+                leader_pose = self.poses.get(self.core.leader)
+            feedback = FleetGoalFeedback(state=state)
+            if errors is not None:
+                feedback.rms_error, feedback.max_error = errors.rms, errors.max
+            if leader_pose is not None:
+                feedback.distance_to_goal = math.hypot(leader_pose.x - t.x, leader_pose.y - t.y)
+            self.action.publish_feedback(feedback)
+            if state in (ARRIVED, ABORTED):
+                result.success, result.message = state == ARRIVED, reason
+                result.duration = (rospy.Time.now() - start).to_sec()
+                (self.action.set_succeeded if state == ARRIVED else self.action.set_aborted)(result, reason)
+                return
+            try:
+                rate.sleep()
+            except rospy.ROSInterruptException:
+                return
+
+    # --- inputs -------------------------------------------------------------------------------
+
+    def _on_map(self, msg):
+        import numpy as np
+
+        grid = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
+        origin = (msg.info.origin.position.x, msg.info.origin.position.y)
+        with self.lock:
+            self.core.free_space = FreeSpace(grid, msg.info.resolution, origin, self.params["map_clearance"])
+
+    def _on_controller(self, msg, robot):
+        self.last_heard_controller[robot] = rospy.Time.now().to_sec()
+
+    def _on_scan(self, msg):
+        self.leader_scan = msg
+
+    def _follow_leader_scan(self, leader):
+        from sensor_msgs.msg import LaserScan
+
+        if self._scan_robot == leader:
+            return
+        if self._scan_sub is not None:
+            self._scan_sub.unregister()
+        self.leader_scan = None
+        self._scan_robot = leader
+        self._scan_sub = rospy.Subscriber("/%s/scan" % leader, LaserScan, self._on_scan, queue_size=1)
+
+    # --- the cycle ----------------------------------------------------------------------------
+
+    def _cycle(self, _event):
+        now_ros = rospy.Time.now()
+        now = now_ros.to_sec()
+        poses = {}
+        for robot in self.robots:
+            try:
+                poses[robot], _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % robot, now_ros,
+                                              self.params["max_pose_age"])
+                self.last_heard_pose[robot] = now
+            except StalePose:
+                pass
+        with self.lock:
+            self.poses = poses
+            leader = self.core.leader
+            last_heard = {}
+            for robot in self.robots:
+                heard = self.last_heard_pose.get(robot, -1e9)
+                if robot != leader:  # a follower also needs its controller
+                    heard = min(heard, self.last_heard_controller.get(robot, -1e9))
+                last_heard[robot] = heard
+            if not self._started(last_heard, now):
+                return
+            self._follow_leader_scan(leader)
+            scan = self.leader_scan
+            obstacle = scan is not None and safety_stop(scan.ranges, scan.angle_min, scan.angle_increment,
+                                                        self.params["pause_distance"], self.params["pause_half_angle"])
+            actions = self.core.update(now, poses, last_heard, self._leader_nav(), obstacle)
+            self._run(actions)
+            self._publish_status()
+            self.marker_pub.publish(markers.fleet_markers(self.core, poses, now_ros))
+            if self.params["debug_mode"] and (self._last_debug is None or now - self._last_debug >= 1.0):
+                self._last_debug = now
+                for robot, (dist, heading) in sorted(self.core.slot_errors(poses).items()):
+                    rospy.loginfo("coordinator: %s slot error %.1f cm, %.1f deg", robot, dist * 100.0,
+                                  math.degrees(heading))
+
+    def _started(self, last_heard, now):
+        """Startup is a wall-time affair (at real_time_factor 0 sim time races ahead while nodes
+        come up): the coordinator starts once every robot was heard, or after ~startup_timeout
+        seconds of wall time, when the absent ones count as lost."""
+
+        if self._startup_done:
+            return True
+        missing = [r for r in self.robots if now - last_heard[r] > self.core.config.loss_timeout]
+        if missing and time.time() - self._wall_start < self.params["startup_timeout"]:
+            rospy.loginfo_throttle(5.0, "coordinator: waiting for %s" % ", ".join(missing))
+            return False
+        if missing:
+            rospy.logerr("coordinator: %s did not come up in %.0f s: starting without them", ", ".join(missing),
+                         self.params["startup_timeout"])
+        self._startup_done = True
+        return True
+
+    def _leader_nav(self):
+        """The state of the goal we gave the leader's move_base, in the words update() takes."""
+        from actionlib_msgs.msg import GoalStatus
+
+        client = self._nav_clients.get(self._nav_robot)
+        if client is None or self._nav_robot != self.core.leader:
+            return None
+        state = client.get_state()
+        if state == GoalStatus.SUCCEEDED:
+            return "SUCCEEDED"
+        if state in (GoalStatus.ABORTED, GoalStatus.REJECTED):
+            return "ABORTED: %s" % client.get_goal_status_text()
+        if state in (GoalStatus.ACTIVE, GoalStatus.PENDING):
+            return "ACTIVE"
+        return None
+
+    def _connect_nav(self):
+        """Connect a move_base client for every robot (any may lead), waiting in wall time: at
+        real_time_factor 0 a wait in sim time would give up before the nav nodes are up."""
+
+        pending = list(self.robots)
+        while pending and not rospy.is_shutdown():
+            for robot in list(pending):
+                if self._nav_clients[robot].wait_for_server(rospy.Duration(0.01)):
+                    self._nav_connected.add(robot)
+                    pending.remove(robot)
+            time.sleep(0.1)
+
+    def _run(self, actions):
+        from mbot_navigation.move_base_client import make_goal
+
+        for action in actions:
+            if action[0] == "assignment":
+                self.assignment_pub.publish(assignment_to_msg(self.core.assignment, rospy.Time.now()))
+            elif action[0] == "goal":
+                _, robot, target = action
+                if self._nav_robot is not None and self._nav_robot != robot:
+                    self._cancel(self._nav_robot)
+                client = self._nav_clients[robot]
+                if robot not in self._nav_connected:
+                    rospy.logerr("coordinator: /%s/move_base is not connected (yet); sending the goal anyway", robot)
+                client.send_goal(make_goal(target.x, target.y, target.theta))
+                self._nav_robot = robot
+                rospy.loginfo("coordinator: %s navigates to (%.2f, %.2f)", robot, target.x, target.y)
+            elif action[0] == "cancel":
+                self._cancel(action[1])
+
+    def _cancel(self, robot):
+        client = self._nav_clients.get(robot)
+        if client is not None and self._nav_robot == robot:
+            client.cancel_all_goals()
+            self._nav_robot = None
+
+    def _publish_status(self, force=False):
+        c = self.core
+        key = (c.state(), c.reason, c.leader, c.formation, tuple(c.members), tuple(c.lost), c.paused)
+        now = rospy.Time.now()
+        if not force and key == self._published_state and self._last_status is not None \
+                and (now - self._last_status).to_sec() < 0.5:
+            return
+        if key != self._published_state:
+            rospy.loginfo("coordinator: %s (%s)", c.state(), c.reason)
+        self._published_state = key
+        self._last_status = now
+        msg = self._FleetStatus()
+        msg.header.stamp = now
+        msg.header.frame_id = "map"
+        msg.state, msg.reason, msg.formation, msg.spacing = c.state(), c.reason, c.formation, c.spacing
+        msg.leader, msg.members, msg.lost, msg.paused = c.leader, list(c.members), list(c.lost), c.paused
+        if c.target is not None:
+            msg.has_target = True
+            msg.target.x, msg.target.y, msg.target.theta = c.target
+        e = c.errors
+        if e is not None:
+            msg.rms_error, msg.max_error, msg.fit_rms_error = e.rms, e.max, e.fit_rms
+            msg.edge_error, msg.heading_error = e.edge_max, e.heading_max
+        self.status_pub.publish(msg)
+
+
+def main():
+    rospy.init_node("coordinator")
+    try:
+        CoordinatorNode()
+    except ValueError as error:
+        rospy.logfatal("coordinator: %s" % error)
+        raise SystemExit(1)
+    rospy.spin()

@@ -1,0 +1,69 @@
+"""What the follower controllers, the coordinator and the metrics collector share on the ROS side:
+the slot assignment as plain data and its message, and tf pose lookups that never wait.
+
+Why lookups never wait: under the simulator's lockstep, sim time stands still until every driven
+robot has sent its command. A lookup that waited in sim time (tf2's timeout) would hold the clock
+it waits for. So a lookup takes the newest transform and refuses it when it is older than a bound.
+"""
+from collections import namedtuple
+
+from mbot_common.geometry import Pose2D, yaw_of
+
+#: The fleet's slot assignment as plain data.
+#: leader: robot name; formation: name; spacing [m]; slots: {robot: (x, y)} in the leader's frame
+#: (the leader's own slot is (0, 0)); follows: {robot: the robot whose pose it tracks}.
+Assignment = namedtuple("Assignment", "leader formation spacing slots follows")
+
+
+class StalePose(Exception):
+    """A tf lookup that failed or whose newest transform is too old; the message says which."""
+
+
+def assignment_from_msg(msg):
+    """mbot_msgs/FleetAssignment -> Assignment."""
+    slots = {s.robot: (s.offset.x, s.offset.y) for s in msg.slots}
+    follows = {s.robot: s.follows for s in msg.slots}
+    return Assignment(msg.leader, msg.formation, msg.spacing, slots, follows)
+
+
+def assignment_to_msg(assignment, stamp):
+    """Assignment -> mbot_msgs/FleetAssignment (the leader's slot first)."""
+    from mbot_msgs.msg import FleetAssignment, SlotAssignment
+
+    msg = FleetAssignment()
+    msg.header.stamp = stamp
+    msg.header.frame_id = "%s/base_link" % assignment.leader
+    msg.leader = assignment.leader
+    msg.formation = assignment.formation
+    msg.spacing = assignment.spacing
+    order = [assignment.leader] + sorted(r for r in assignment.slots if r != assignment.leader)
+    for robot in order:
+        slot = SlotAssignment()
+        slot.robot = robot
+        slot.offset.x, slot.offset.y = assignment.slots[robot]
+        slot.follows = assignment.follows.get(robot, "")
+        msg.slots.append(slot)
+    return msg
+
+
+def lookup_pose(buffer, target_frame, source_frame, now, max_age):
+    """Pose of `source_frame` in `target_frame` from the newest transform in a tf2 Buffer.
+
+    :param now: rospy.Time (sim time) the age is measured against
+    :param max_age: [s] oldest acceptable transform
+    :returns: (Pose2D, stamp)
+    :raises StalePose: no transform, or the newest one is older than max_age
+    """
+    import rospy
+    import tf2_ros
+
+    try:
+        t = buffer.lookup_transform(target_frame, source_frame, rospy.Time(0))
+    except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as error:
+        raise StalePose("%s -> %s: %s" % (target_frame, source_frame, str(error).splitlines()[0]))
+    age = (now - t.header.stamp).to_sec()
+    if age > max_age:
+        raise StalePose("%s -> %s: newest transform is %.2f s old (limit %.2f s)" % (
+            target_frame, source_frame, age, max_age))
+    tr = t.transform.translation
+    return Pose2D(tr.x, tr.y, yaw_of(t.transform.rotation)), t.header.stamp

@@ -1,0 +1,319 @@
+"""Node ``follower_controller``: one per robot, in the robot's namespace (``/follower_1/...``).
+
+Every control period (sim time) it
+
+1. reads its private parameters again (every ``~param_refresh`` s), so ``rosparam set`` of a gain
+   or limit takes effect without a restart;
+2. looks up its pose in the leader's frame from tf2 (``<leader>/base_link -> <ns>/base_link``);
+   a failed or stale lookup skips the control law and holds the robot still: it never acts on
+   old data. Lookups and failures are counted and published;
+3. picks its target: its slot from ``/fleet/assignment``, or, when the slot or the straight way
+   to it is blocked (a wall, its inflation, something the laser sees), a point on the leader's
+   recent path (the trail) as far behind the leader as the slot is: a path the leader drove is
+   free, and the follower rejoins its slot once the way is clear again;
+4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
+   the command, and applies the safety layer first: anything closer than ``safety_distance`` in
+   the front +-``safety_half_angle`` stops the robot's forward motion;
+5. publishes ``cmd_vel``, ``power`` (the energy model's rate) and ``~state`` (FollowerState).
+
+While its robot leads (the assignment names it), the node publishes no command: the robot's
+move_base drives it. Before the first assignment, and while the fleet is IDLE, ABORTED or paused,
+it holds the robot still (zero commands, so the simulator's lockstep keeps waiting for it).
+"""
+import math
+import time
+
+import rospy
+
+from mbot_common.geometry import Pose2D, Twist2D, compose, relative
+from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, energy_rate,
+                                        make_control_law, safety_stop)
+from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
+from mbot_follower.free_space import FreeSpace
+from mbot_follower.trail import Trail
+
+#: Private parameters of the node itself (the control law's are ControllerConfig's fields).
+NODE_PARAMS = {
+    "rate": 20.0,             # control frequency [Hz sim time]
+    "max_pose_age": 0.1,      # oldest tf pose the controller acts on [s]
+    "controller": "slot_tracking",  # control law: slot_tracking or consensus
+    "param_refresh": 0.5,     # how often the private parameters are read again [s sim time]
+    "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
+    "scan_clearance": 0.35,   # a laser point closer than this to the way to the slot blocks it [m]
+    "scan_horizon": 2.0,      # how far along the way to the slot the laser check looks [m]
+}
+HOLD_STATES = ("IDLE", "ABORTED")
+
+
+class FollowerController(object):
+    """The ROS side of one follower: subscriptions, tf, parameters and publishing."""
+
+    def __init__(self):
+        import tf2_ros
+        from geometry_msgs.msg import Twist
+        from mbot_msgs.msg import FleetAssignment, FleetStatus, FollowerState
+        from nav_msgs.msg import OccupancyGrid, Odometry
+        from sensor_msgs.msg import LaserScan
+        from std_msgs.msg import Float64
+
+        self._msg = {"Twist": Twist, "FollowerState": FollowerState, "Float64": Float64, "Odometry": Odometry}
+        self.robot = rospy.get_namespace().strip("/")
+        if not self.robot:
+            raise ValueError("follower_controller must run in a robot's namespace (ns=\"follower_1\")")
+        self.params = dict(NODE_PARAMS)
+        self.config = ControllerConfig()
+        self._config_keys = set(vars(ControllerConfig()))
+        self._warned_keys = set()
+        self._read_params(startup=True)
+        self.law = make_control_law(self.params["controller"])
+        self.filter = CommandFilter(self.config)
+
+        self.assignment = None
+        self.fleet_state = "IDLE"
+        self.paused = False
+        self.scan = None
+        self.free_space = None
+        self.trail = Trail()
+        self.leader_twist = Twist2D(0.0, 0.0, 0.0)
+        self._leader_odom_sub = None
+        self._leader_sub_name = None
+        self._was_driving = False
+        self._last_param_read = None
+        self.lookups = 0
+        self.lookup_failures = 0
+
+        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
+        self._tf_listener = tf2_ros.TransformListener(self.tf_buffer)
+        self.cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=1)
+        self.power_pub = rospy.Publisher("power", Float64, queue_size=1)
+        self.state_pub = rospy.Publisher("~state", FollowerState, queue_size=10)
+        rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=1)
+        rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
+        rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1)
+        rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
+        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), self._cycle)
+        rospy.loginfo("%s: follower controller (%s) ready", rospy.get_name(), self.params["controller"])
+
+    # --- parameters ---------------------------------------------------------------------------
+
+    def _read_params(self, startup=False):
+        """Read every private parameter: node settings and the control law's gains and limits.
+        A bad value is refused with an error naming it; the previous value stays."""
+        values = rospy.get_param("~", {})
+        for key, value in values.items():
+            if key in NODE_PARAMS:
+                if startup:
+                    self.params[key] = type(NODE_PARAMS[key])(value)
+            elif key in self._config_keys:
+                try:
+                    self.config.update({key: value})
+                except ValueError as error:
+                    if startup:
+                        raise
+                    rospy.logerr_throttle(5.0, "%s: parameter ~%s refused: %s" % (rospy.get_name(), key, error))
+            elif key not in self._warned_keys:
+                self._warned_keys.add(key)
+                message = "%s: unknown parameter ~%s (known: %s)" % (
+                    rospy.get_name(), key, ", ".join(sorted(set(NODE_PARAMS) | self._config_keys)))
+                if startup:
+                    raise ValueError(message)
+                rospy.logerr(message)
+
+    # --- inputs -------------------------------------------------------------------------------
+
+    def _on_assignment(self, msg):
+        self.assignment = assignment_from_msg(msg)
+        reference = self.assignment.follows.get(self.robot) or self.assignment.leader
+        if self._leader_sub_name != reference:
+            if self._leader_odom_sub is not None:
+                self._leader_odom_sub.unregister()
+            self._leader_sub_name = reference
+            self.leader_twist = Twist2D(0.0, 0.0, 0.0)
+            self.trail.clear()
+            self._leader_odom_sub = rospy.Subscriber(
+                "/%s/odom" % reference, self._msg["Odometry"], self._on_leader_odom, queue_size=1)
+
+    def _on_status(self, msg):
+        self.fleet_state = msg.state
+        self.paused = msg.paused
+
+    def _on_scan(self, msg):
+        self.scan = msg
+
+    def _on_map(self, msg):
+        import numpy as np
+
+        grid = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
+        origin = (msg.info.origin.position.x, msg.info.origin.position.y)
+        self.free_space = FreeSpace(grid, msg.info.resolution, origin, self.params["map_clearance"])
+
+    def _on_leader_odom(self, msg):
+        t = msg.twist.twist
+        self.leader_twist = Twist2D(t.linear.x, t.linear.y, t.angular.z)
+
+    # --- the control cycle --------------------------------------------------------------------
+
+    def _cycle(self, _event):
+        started = time.time()
+        now = rospy.Time.now()
+        if self._last_param_read is None or (now - self._last_param_read).to_sec() >= self.params["param_refresh"]:
+            self._read_params()
+            self._last_param_read = now
+        a = self.assignment
+        if a is None or self.robot not in a.slots:
+            # Not (yet) in the formation: stand still. The command also tells the simulator's
+            # lockstep to wait for this node, so sim time cannot run away from the fleet.
+            self._hold()
+            self._publish_state(now, "idle", started)
+            return
+        if a.leader == self.robot:
+            if self._was_driving:  # handing the robot over to its move_base: stop once
+                self._send(Twist2D(0.0, 0.0, 0.0))
+                self.filter.reset()
+                self._was_driving = False
+            self._publish_state(now, "leading", started)
+            return
+        if self.fleet_state in HOLD_STATES or self.paused:
+            self._hold()
+            self._publish_state(now, "paused" if self.paused else "hold", started)
+            return
+
+        # star: every follower tracks the leader; chain: the robot ahead of it (a.follows)
+        reference = a.follows.get(self.robot) or a.leader
+        if reference not in a.slots:
+            reference = a.leader
+        age = self.params["max_pose_age"]
+        try:
+            self.lookups += 1
+            pose, stamp = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % self.robot,
+                                      now, age)
+            ref_map, _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % reference, now, age)
+            leader_map = ref_map if reference == a.leader else lookup_pose(
+                self.tf_buffer, "map", "%s/base_link" % a.leader, now, age)[0]
+        except StalePose as error:
+            self.lookup_failures += 1
+            rospy.logwarn_throttle(2.0, "%s: no current pose, holding still: %s" % (rospy.get_name(), error))
+            self._hold()
+            self._publish_state(now, "no_pose", started)
+            return
+
+        self.trail.add(leader_map.x, leader_map.y)
+        slot = self._slot_relative_to(a, reference)
+        target, mode = self._target(slot, pose, ref_map)
+        neighbours = self._neighbours(a, now) if self.params["controller"] == "consensus" else []
+        twist = self.leader_twist if mode == "slot" else Twist2D(self.leader_twist.vx, 0.0, 0.0)
+        cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
+        cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
+        # The safety layer has the last word: smoothing must not carry the robot on into something.
+        if self.scan is not None and safety_stop(self.scan.ranges, self.scan.angle_min, self.scan.angle_increment,
+                                                 self.config.safety_distance, self.config.safety_half_angle):
+            self.filter.reset()
+            cmd = Twist2D(0.0, 0.0, cmd.wz)
+            mode = "safety_stop"
+        self._send(cmd)
+        self._was_driving = True
+        err = (slot[0] - pose.x, slot[1] - pose.y)
+        self._publish_state(now, mode, started, stamp, err, -pose.theta, cmd)
+
+    def _slot_relative_to(self, a, reference):
+        """The robot's slot seen from the robot it tracks (slots are given in the leader's frame;
+        the formation is taken to face the way its reference faces)."""
+        sx, sy = a.slots[self.robot]
+        rx, ry = a.slots[reference]
+        return sx - rx, sy - ry
+
+    def _target(self, slot, pose, ref_map):
+        """(target in the reference robot's frame, mode): the slot, or the trail point when the
+        slot or the way to it is blocked."""
+        slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
+        me_map = compose(ref_map, pose)
+        blocked = False
+        if self.free_space is not None:
+            blocked = not self.free_space.is_free(slot_map.x, slot_map.y) or not self.free_space.segment_free(
+                me_map.x, me_map.y, slot_map.x, slot_map.y)
+        if not blocked:
+            blocked = self._scan_blocks(pose, slot)
+        if not blocked or len(self.trail) < 2:
+            return slot, "slot"
+        tx, ty = self.trail.point_behind(math.hypot(slot[0], slot[1]))
+        t = relative(ref_map, Pose2D(tx, ty, 0.0))
+        return (t.x, t.y), "trail"
+
+    def _scan_blocks(self, pose, slot):
+        """True when a laser point lies near the straight way from the robot towards its slot
+        (the first scan_horizon metres). Points within the leader's footprint are the leader."""
+        scan = self.scan
+        if scan is None:
+            return False
+        # the way to the slot in the follower's own frame
+        dx, dy = slot[0] - pose.x, slot[1] - pose.y
+        c, s = math.cos(-pose.theta), math.sin(-pose.theta)
+        gx, gy = c * dx - s * dy, s * dx + c * dy
+        length = math.hypot(gx, gy)
+        if length < 1e-6:
+            return False
+        ux, uy = gx / length, gy / length
+        horizon = min(length, self.params["scan_horizon"])
+        clearance = self.params["scan_clearance"]
+        for i, r in enumerate(scan.ranges):
+            if not (scan.range_min <= r <= horizon + clearance):
+                continue
+            a = scan.angle_min + i * scan.angle_increment
+            px, py = r * math.cos(a), r * math.sin(a)
+            along = px * ux + py * uy
+            if 0.0 <= along <= horizon and abs(-px * uy + py * ux) < clearance:
+                return True
+        return False
+
+    def _neighbours(self, a, now):
+        """The other followers' poses in the leader's frame with their slots (for consensus)."""
+        result = []
+        for robot, slot in a.slots.items():
+            if robot in (self.robot, a.leader):
+                continue
+            try:
+                pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % a.leader, "%s/base_link" % robot, now,
+                                      self.params["max_pose_age"])
+            except StalePose:
+                continue
+            result.append((pose, slot))
+        return result
+
+    # --- outputs ------------------------------------------------------------------------------
+
+    def _hold(self):
+        self.filter.reset()
+        self._send(Twist2D(0.0, 0.0, 0.0))
+
+    def _send(self, cmd):
+        msg = self._msg["Twist"]()
+        msg.linear.x, msg.linear.y, msg.angular.z = cmd.vx, cmd.vy, cmd.wz
+        self.cmd_pub.publish(msg)
+        self.power_pub.publish(self._msg["Float64"](energy_rate(cmd, self.config.energy_k_v, self.config.energy_k_w)))
+
+    def _publish_state(self, now, mode, started, pose_stamp=None, err=(0.0, 0.0), heading_error=0.0, cmd=None):
+        msg = self._msg["FollowerState"]()
+        msg.header.stamp = now
+        msg.robot = self.robot
+        msg.active = mode in ("slot", "trail", "safety_stop")
+        msg.mode = mode
+        if pose_stamp is not None:
+            msg.pose_stamp = pose_stamp
+        msg.slot_error.x, msg.slot_error.y = err
+        msg.heading_error = heading_error
+        if cmd is not None:
+            msg.cmd.linear.x, msg.cmd.linear.y, msg.cmd.angular.z = cmd.vx, cmd.vy, cmd.wz
+        msg.lookups = self.lookups
+        msg.lookup_failures = self.lookup_failures
+        msg.cycle_time = time.time() - started
+        self.state_pub.publish(msg)
+
+
+def main():
+    rospy.init_node("follower_controller")
+    try:
+        FollowerController()
+    except ValueError as error:
+        rospy.logfatal("%s: %s" % (rospy.get_name(), error))
+        raise SystemExit(1)
+    rospy.spin()

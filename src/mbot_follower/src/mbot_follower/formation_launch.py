@@ -1,0 +1,73 @@
+"""Bring up a formation fleet from a world file: what mbot_navigation's fleet launcher starts
+(the map server, every robot's localization and navigation) plus one ``follower_controller``
+per robot, in its namespace. formation.launch starts this node (``formation_fleet``) next to the
+simulator and the coordinator; roslaunch has no loops, so the per-robot part is generated.
+
+Every robot gets a controller, the leader too: its controller stays passive while it leads, and
+takes over if the leader role moves to another robot (a lost leader is replaced; a robot that
+comes back rejoins as a follower).
+"""
+from xml.sax.saxutils import quoteattr
+
+from mbot_navigation.fleet_launch import (LOCALIZATIONS, find_maps_directory, fleet_launch_xml, read_world,
+                                          resolve_world_path, run_launch_text)
+
+OMNI_MODELS = ("mbot_omni",)
+
+
+def controller_lines(world, controller="slot_tracking", output="log", config_file="", leader_max_vel=0.0):
+    """Launch XML lines: one follower_controller node per robot of `world`, and, when
+    leader_max_vel > 0, that speed limit [m/s] for every robot's move_base (any robot may lead):
+    followers can only keep up with a leader slower than themselves."""
+    lines = []
+    for robot in world.robots:
+        if leader_max_vel > 0.0:
+            lines.append('  <param name=%s value="%g"/>' % (
+                quoteattr("/%s/move_base/DWAPlannerROS/max_vel_x" % robot.name), leader_max_vel))
+        lines.append('  <node pkg="mbot_follower" type="follower_controller" name="follower_controller" ns=%s '
+                     'output=%s>' % (quoteattr(robot.name), quoteattr(output)))
+        if config_file:
+            lines.append('    <rosparam file=%s command="load"/>' % quoteattr(config_file))
+        lines.append('    <param name="controller" value=%s/>' % quoteattr(controller))
+        lines.append('    <param name="omni" value="%s"/>' % ("true" if robot.model in OMNI_MODELS else "false"))
+        lines.append("  </node>")
+    return lines
+
+
+def parse_args(argv):
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="formation_fleet", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--world", required=True, help="world name (maps/NAME.world.yaml) or path")
+    parser.add_argument("--localization", default="fake", choices=LOCALIZATIONS)
+    parser.add_argument("--controller", default="slot_tracking")
+    parser.add_argument("--controller-config", default="", help="yaml of follower_controller parameters")
+    parser.add_argument("--leader-max-vel", type=float, default=0.0, help="move_base speed limit [m/s]; 0: the model's")
+    parser.add_argument("--config-dir", default="", help="folder with the nav_*.yaml files")
+    parser.add_argument("--output", default="log", choices=("log", "screen"))
+    return parser.parse_args([a for a in argv if ":=" not in a])
+
+
+def main(argv=None):
+    """Node ``formation_fleet`` (no rospy, like fleet_navigation: only roslaunch's API)."""
+    import sys
+
+    import rospkg
+
+    from mbot_follower.control_laws import CONTROL_LAWS
+
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        if args.controller not in CONTROL_LAWS:
+            raise ValueError("controller %r: expected one of %s" % (args.controller, ", ".join(sorted(CONTROL_LAWS))))
+        maps = find_maps_directory(rospkg.RosPack().get_path("mbot_follower"))
+        world = read_world(resolve_world_path(args.world, maps))
+        text = fleet_launch_xml(world, args.localization, config_dir=args.config_dir, output=args.output,
+                                extra_lines=controller_lines(world, args.controller, args.output,
+                                                             args.controller_config, args.leader_max_vel))
+    except ValueError as error:
+        print("formation_fleet: %s" % error, file=sys.stderr)
+        return 1
+    print("formation_fleet: %d robots of %s: %s (controller %s)" % (
+        len(world.robots), world.path, ", ".join(r.name for r in world.robots), args.controller))
+    return run_launch_text(text, "formation_fleet")

@@ -1,0 +1,417 @@
+#!/usr/bin/python3
+"""The checks a course runs on a formation fleet, as an outside client would run them: send
+targets and switches on the public topics, kill nodes, set parameters, and measure the result
+from the simulator's ground truth (not from what the coordinator says about itself).
+
+The check is chosen by the private parameter ~check (one .test file per check):
+  triangle  - the triangle drives to (5, 0) via /simulation/target_pose: slot RMS while moving
+              < 0.15 m, ARRIVED, no contact
+  obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
+  switch    - switch to `line` while moving: the line is reached
+  loss      - follower_1's controller is killed: DEGRADED within 1 s of the loss, the others ARRIVE
+  limit     - max_linear_vel 0.3 on follower_1: its speed stays <= 0.3 m/s while the leader's does not
+  corridor  - 4 robots diamond -> column -> diamond through the corridor, no contact
+  leader_loss - the leader is removed from the simulator: a follower takes over, the fleet ARRIVES
+  rejoin    - a follower removed and spawned again rejoins a slot
+  refuse    - unknown formation, NaN target, target in a wall: refused, state unchanged
+Everything waits in sim time with a wall-clock bound.
+"""
+import math
+import subprocess
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from geometry_msgs.msg import Pose2D as Pose2DMsg
+from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus
+from nav_msgs.msg import Odometry
+from std_msgs.msg import String
+
+from mbot_common.geometry import Pose2D, compose, yaw_of
+
+WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
+
+
+class FleetProbe(object):
+    """Records the fleet: ground truth of every robot, status, assignment, contacts."""
+
+    def __init__(self, robots):
+        self.lock = threading.Lock()
+        self.robots = robots
+        self.truth = {}        # robot -> (t, Pose2D, speed)
+        self.samples = []      # (t, state, {robot: Pose2D}, {robot: speed}, assignment)
+        self.status = None
+        self.states = []       # (t, state, reason)
+        self.assignment = None
+        self.contacts = []
+        for r in robots:
+            rospy.Subscriber("/%s/base_pose_ground_truth" % r, Odometry, self._on_truth, callback_args=r, queue_size=5)
+        rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=50)
+        rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=5)
+        rospy.Subscriber("/contacts", Contact, self._on_contact, queue_size=100)
+        self.target_pub = rospy.Publisher("/simulation/target_pose", Pose2DMsg, queue_size=1, latch=True)
+        self.formation_pub = rospy.Publisher("/fleet/formation", String, queue_size=1, latch=True)
+        self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
+
+    def _on_truth(self, msg, robot):
+        p = msg.pose.pose
+        v = msg.twist.twist.linear
+        with self.lock:
+            self.truth[robot] = (msg.header.stamp.to_sec(), Pose2D(p.position.x, p.position.y, yaw_of(p.orientation)),
+                                 math.hypot(v.x, v.y))
+
+    def _on_status(self, msg):
+        with self.lock:
+            if self.status is None or msg.state != self.status.state:
+                self.states.append((rospy.get_time(), msg.state, msg.reason))
+            self.status = msg
+
+    def _on_assignment(self, msg):
+        with self.lock:
+            self.assignment = msg
+
+    def _on_contact(self, msg):
+        with self.lock:
+            self.contacts.append(msg)
+
+    def _sample(self, _event):
+        with self.lock:
+            if self.status is None:
+                return
+            poses = {r: v[1] for r, v in self.truth.items()}
+            speeds = {r: v[2] for r, v in self.truth.items()}
+            self.samples.append((rospy.get_time(), self.status.state, poses, speeds, self.assignment))
+
+    # --- measures -----------------------------------------------------------------------------
+
+    @staticmethod
+    def slot_errors(poses, assignment):
+        """{follower: distance to its slot} from ground truth poses and an assignment message."""
+        if assignment is None or assignment.leader not in poses:
+            return {}
+        leader = poses[assignment.leader]
+        errors = {}
+        for s in assignment.slots:
+            if s.robot == assignment.leader or s.robot not in poses:
+                continue
+            slot = compose(leader, Pose2D(s.offset.x, s.offset.y, 0.0))
+            errors[s.robot] = math.hypot(poses[s.robot].x - slot.x, poses[s.robot].y - slot.y)
+        return errors
+
+    def state(self):
+        with self.lock:
+            return self.status.state if self.status else None
+
+    def wait(self, condition, sim_timeout, what):
+        """Wait until condition() (sim time, wall-bounded); fail naming `what` and the fleet's state."""
+        start = rospy.get_time()
+        wall_end = time.time() + WALL_LIMIT
+        while not rospy.is_shutdown() and time.time() < wall_end:
+            if condition():
+                return rospy.get_time()
+            if rospy.get_time() - start > sim_timeout:
+                break
+            time.sleep(0.01)
+        with self.lock:
+            s = self.status
+        raise AssertionError("timed out after %.0f s sim waiting for %s (fleet: %s, %s)" % (
+            rospy.get_time() - start, what, s.state if s else "no status", s.reason if s else ""))
+
+    def wait_for_fleet(self, wall_timeout=120.0):
+        """Wait in wall time (at real_time_factor 0 sim time races ahead while the nodes start)
+        for the coordinator, every robot's ground truth, controller and move_base."""
+        from mbot_msgs.msg import FollowerState
+        from mbot_navigation.move_base_client import connect_move_base
+
+        heard = set()
+        subs = [rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
+                                 lambda msg, r=r: heard.add(r), queue_size=1) for r in self.robots]
+        end = time.time() + wall_timeout
+        while time.time() < end and not rospy.is_shutdown():
+            with self.lock:
+                ready = self.status is not None and len(self.truth) == len(self.robots) and len(heard) == len(self.robots)
+            if ready:
+                break
+            time.sleep(0.1)
+        for sub in subs:
+            sub.unregister()
+        if not ready:
+            raise AssertionError("fleet not up after %.0f s wall: status %s, ground truth of %s, controllers of %s" % (
+                wall_timeout, self.status is not None, sorted(self.truth), sorted(heard)))
+        for r in self.robots:
+            connect_move_base(r, max(1.0, end - time.time()))
+
+    def send_target(self, x, y, theta=0.0):
+        self.target_pub.publish(Pose2DMsg(x, y, theta))
+
+    def samples_in(self, states, since=0.0):
+        with self.lock:
+            return [s for s in self.samples if s[1] in states and s[0] >= since]
+
+
+def robots_param():
+    return rospy.get_param("~robots")
+
+
+class FormationChecks(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("formation_checks")
+        cls.check = rospy.get_param("~check")
+        cls.probe = FleetProbe(robots_param())
+        cls.probe.wait_for_fleet()
+
+    def assertNoContacts(self):
+        self.assertEqual(self.probe.contacts, [], "contacts: %s" % [
+            "%s-%s at t=%.1f" % (c.body_a, c.body_b, c.header.stamp.to_sec()) for c in self.probe.contacts])
+
+    def drive_and_arrive(self, x, y, timeout=180.0):
+        p = self.probe
+        p.send_target(x, y)
+        p.wait(lambda: p.state() in ("FORMING", "NAVIGATING"), 10.0, "the goal to be taken")
+        t = p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), timeout, "ARRIVED")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        return t
+
+    def steady_rms(self, since, moving=0.1):
+        """RMS of the followers' slot errors while the fleet moves: NAVIGATING samples after
+        `since` in which the leader drives at `moving` [m/s] or more (its start and its final
+        braking and turning on the spot are transients, not the steady state). Logs the error
+        every 2 s so that a failure shows where it grew."""
+        errors = []
+        for (t, state, poses, speeds, a) in self.probe.samples_in(("NAVIGATING", "DEGRADED"), since):
+            e = self.probe.slot_errors(poses, a)
+            if int(t * 10) % 20 == 0:
+                rospy.loginfo("t=%.1f %s leader speed %.2f m/s, slot errors %s", t, state,
+                              speeds.get(a.leader, 0.0) if a else 0.0, {k: round(v, 3) for k, v in e.items()})
+            if a is not None and speeds.get(a.leader, 0.0) >= moving:
+                errors += e.values()
+        self.assertGreater(len(errors), 20, "too few samples while NAVIGATING")
+        return math.sqrt(sum(e * e for e in errors) / len(errors))
+
+    def leader_at(self, x, y, tolerance=0.35):
+        p = self.probe
+        leader = p.status.leader
+        pose = p.truth[leader][1]
+        self.assertLess(math.hypot(pose.x - x, pose.y - y), tolerance, "%s ended at (%.2f, %.2f)" % (
+            leader, pose.x, pose.y))
+
+    def test_check(self):
+        getattr(self, "run_" + self.check)()
+
+    # --- the checks ---------------------------------------------------------------------------
+
+    def run_triangle(self):
+        p = self.probe
+        self.assertEqual(p.state(), "IDLE")
+        self.drive_and_arrive(5.0, 0.0)
+        navigating = [s[0] for s in p.samples_in(("NAVIGATING",))]
+        # steady: from 3 s after the leader set off (it accelerates, the followers catch up)
+        rms = self.steady_rms(navigating[0] + 3.0)
+        rospy.loginfo("triangle: steady slot RMS while moving %.3f m", rms)
+        self.assertLess(rms, 0.15)
+        self.leader_at(5.0, 0.0)
+        final = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
+        self.assertLess(max(final.values()), 0.3, "final slot errors %s" % final)
+        self.assertNoContacts()
+
+    def run_switch(self):
+        p = self.probe
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING" and p.truth[p.status.leader][1].x > -3.5, 120.0,
+               "the leader on its way")
+        t_switch = rospy.get_time()
+        p.formation_pub.publish(String("line"))
+        p.wait(lambda: p.assignment.formation == "line", 5.0, "the line assignment")
+        slots = [s for s in p.assignment.slots if s.robot != p.assignment.leader]
+        self.assertTrue(all(abs(s.offset.x) < 1e-6 for s in slots), "line slots are beside the leader")
+
+        def in_line():
+            errors = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
+            return errors and max(errors.values()) < 0.3
+
+        t_reached = p.wait(in_line, 60.0, "the followers on their line slots")
+        rospy.loginfo("switch: line reached %.1f s after the switch", t_reached - t_switch)
+        self.drive_and_arrive_after_switch()
+        self.assertNoContacts()
+
+    def drive_and_arrive_after_switch(self):
+        p = self.probe
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 180.0, "ARRIVED")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.assertEqual(p.status.formation, "line")
+        self.leader_at(5.0, 0.0)
+
+    def run_loss(self):
+        p = self.probe
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING" and p.truth[p.status.leader][1].x > -3.5, 120.0,
+               "the leader on its way")
+        subprocess.check_call(["rosnode", "kill", "/follower_1/follower_controller"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        t_kill = rospy.get_time()
+        t_degraded = p.wait(lambda: p.state() == "DEGRADED", 10.0, "DEGRADED")
+        rospy.loginfo("loss: DEGRADED %.2f s after the kill", t_degraded - t_kill)
+        # loss = 1 s without a heartbeat; DEGRADED must follow within 1 s of that
+        self.assertLess(t_degraded - t_kill, 2.0)
+        self.assertIn("follower_1", p.status.lost)
+        self.assertNotIn("follower_1", [s.robot for s in p.assignment.slots])
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 180.0, "ARRIVED")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.leader_at(5.0, 0.0)
+        final = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
+        self.assertEqual(set(final), {"follower_2"})
+        self.assertLess(final["follower_2"], 0.3)
+        self.assertNoContacts()
+
+    def run_limit(self):
+        p = self.probe
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING", 120.0, "NAVIGATING")
+        t_set = rospy.get_time()
+        subprocess.check_call(["rosparam", "set", "/follower_1/follower_controller/max_linear_vel", "0.3"])
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED")
+        after = [s for s in p.samples if s[0] >= t_set + 1.0]
+        f1 = max(s[3].get("follower_1", 0.0) for s in after)
+        leader = max(s[3].get("leader", 0.0) for s in after)
+        rospy.loginfo("limit: follower_1 max speed %.3f m/s, leader max speed %.3f m/s", f1, leader)
+        self.assertLessEqual(f1, 0.3 + 0.02)
+        self.assertGreater(f1, 0.2, "follower_1 should still drive")
+        self.assertGreater(leader, 0.33, "the leader must keep its own speed (0.35 m/s)")
+        self.assertNoContacts()
+
+    def run_obstacle(self):
+        from mbot_msgs.srv import SpawnObstacle
+
+        p = self.probe
+        rospy.wait_for_service("/spawn_obstacle", 30.0)
+        spawn = rospy.ServiceProxy("/spawn_obstacle", SpawnObstacle)
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING" and p.truth["leader"][1].x > -3.0, 120.0, "the leader on its way")
+        leader = p.truth["leader"][1]
+        box = (leader.x + 2.0, leader.y)
+        answer = spawn(name="box_1", shape="cylinder", radius=0.25, pose=Pose2DMsg(box[0], box[1], 0.0))
+        self.assertTrue(answer.success, answer.message)
+        p.wait(lambda: p.status.paused, 20.0, "the fleet to pause for the obstacle")
+        t_pause = rospy.get_time()
+        p.wait(lambda: not p.status.paused, 20.0, "the fleet to resume")
+        rospy.loginfo("obstacle: paused for %.1f s", rospy.get_time() - t_pause)
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.leader_at(5.0, 0.0)
+        # Everyone got past the box: nobody ends up west of it.
+        for r, (_, pose, _) in p.truth.items():
+            self.assertGreater(pose.x, box[0] - 3.0, "%s stayed behind the obstacle at x = %.2f" % (r, pose.x))
+        self.assertNoContacts()
+
+    def run_corridor(self):
+        """Diamond -> column before the 1.5 m corridor, through it, back to diamond after; the
+        goal through the action /fleet/goal, the switches through the service."""
+        import actionlib
+        from mbot_msgs.msg import FleetGoalAction, FleetGoalGoal
+        from mbot_msgs.srv import SetFormation
+
+        p = self.probe
+        client = actionlib.SimpleActionClient("/fleet/goal", FleetGoalAction)
+        self.assertTrue(client.wait_for_server(rospy.Duration(30.0)), "no /fleet/goal action server")
+        rospy.wait_for_service("/fleet/set_formation", 30.0)
+        switch = rospy.ServiceProxy("/fleet/set_formation", SetFormation)
+        client.send_goal(FleetGoalGoal(target=Pose2DMsg(13.0, 0.0, 0.0), formation="diamond", spacing=1.5))
+        p.wait(lambda: p.state() == "NAVIGATING", 120.0, "NAVIGATING in a diamond")
+        self.assertEqual(p.assignment.formation, "diamond")
+        answer = switch(formation="column", spacing=0.0)
+        self.assertTrue(answer.success, answer.message)
+        p.wait(lambda: p.assignment.formation == "column", 5.0, "the column assignment")
+        p.wait(lambda: self.formed(0.3), 60.0, "the column formed")
+        self.assertLess(p.truth[p.status.leader][1].x, -10.0, "the column must form before the corridor")
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 300.0, "ARRIVED through the corridor")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.assertTrue(client.wait_for_result(rospy.Duration(10.0)))
+        result = client.get_result()
+        self.assertTrue(result.success, result.message)
+        answer = switch(formation="diamond", spacing=0.0)
+        self.assertTrue(answer.success, answer.message)
+        p.wait(lambda: p.assignment.formation == "diamond", 5.0, "the diamond assignment")
+        p.wait(lambda: self.formed(0.3), 90.0, "the diamond formed again after the corridor")
+        self.leader_at(13.0, 0.0)
+        self.assertNoContacts()
+
+    def formed(self, tolerance):
+        errors = self.probe.slot_errors({r: v[1] for r, v in self.probe.truth.items()}, self.probe.assignment)
+        return bool(errors) and max(errors.values()) < tolerance
+
+    def run_leader_loss(self):
+        from mbot_msgs.srv import RemoveRobot
+
+        p = self.probe
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING" and p.truth["leader"][1].x > -3.5, 120.0, "the leader on its way")
+        remove = rospy.ServiceProxy("/remove_robot", RemoveRobot)
+        answer = remove(name="leader")
+        self.assertTrue(answer.success, answer.message)
+        t_loss = rospy.get_time()
+        with p.lock:
+            del p.truth["leader"]
+        t_degraded = p.wait(lambda: p.state() == "DEGRADED" and p.status.leader != "leader", 10.0,
+                            "a new leader")
+        rospy.loginfo("leader_loss: %s leads %.2f s after the loss", p.status.leader, t_degraded - t_loss)
+        self.assertLess(t_degraded - t_loss, 2.0)
+        self.assertIn(p.status.leader, ("follower_1", "follower_2"))
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED under the new leader")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.leader_at(5.0, 0.0)
+        self.assertTrue(self.formed(0.3), "the two left are not in formation")
+        self.assertNoContacts()
+
+    def run_rejoin(self):
+        from mbot_msgs.srv import RemoveRobot, SpawnRobot
+
+        p = self.probe
+        p.send_target(5.0, 0.0)
+        p.wait(lambda: p.state() == "NAVIGATING" and p.truth["leader"][1].x > -3.5, 120.0, "the leader on its way")
+        answer = rospy.ServiceProxy("/remove_robot", RemoveRobot)(name="follower_2")
+        self.assertTrue(answer.success, answer.message)
+        t_loss = rospy.get_time()
+        p.wait(lambda: p.state() == "DEGRADED" and "follower_2" in p.status.lost, 10.0, "follower_2 lost")
+        self.assertLess(rospy.get_time() - t_loss, 2.0)
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED without follower_2")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        # follower_2 comes back near the fleet and takes a slot again, without restarting anyone
+        answer = rospy.ServiceProxy("/spawn_robot", SpawnRobot)(name="follower_2", model="mbot",
+                                                                  pose=Pose2DMsg(1.0, -3.0, 0.0))
+        self.assertTrue(answer.success, answer.message)
+        t_back = rospy.get_time()
+        p.wait(lambda: "follower_2" not in p.status.lost and "follower_2" in [s.robot for s in p.assignment.slots],
+               20.0, "follower_2 to rejoin")
+        p.wait(lambda: self.formed(0.3), 90.0, "the triangle formed again")
+        rospy.loginfo("rejoin: back in formation %.1f s after the respawn", rospy.get_time() - t_back)
+        self.assertNoContacts()
+
+    def run_refuse(self):
+        from mbot_msgs.srv import SetFormation
+
+        p = self.probe
+        rospy.wait_for_service("/fleet/set_formation", 30.0)
+        switch = rospy.ServiceProxy("/fleet/set_formation", SetFormation)
+        before = (p.state(), p.assignment.formation if p.assignment else None)
+        answer = switch(formation="hexagon", spacing=0.0)
+        self.assertFalse(answer.success)
+        self.assertIn("hexagon", answer.message)
+        self.assertIn("triangle", answer.message, "the refusal should list the known formations")
+        for target, words in (((float("nan"), 0.0), "not a finite pose"), ((10.5, 0.0), "off the map"),
+                              ((9.95, 0.0), "in a wall")):
+            p.send_target(*target)
+            p.wait(lambda: words in p.status.reason, 10.0, "the refusal %r in the status" % words)
+            self.assertEqual((p.state(), p.assignment.formation if p.assignment else None), before)
+        p.formation_pub.publish(String("hexagon"))
+        p.wait(lambda: "hexagon" in p.status.reason, 10.0, "the refusal of hexagon in the status")
+        self.assertEqual(p.state(), "IDLE")
+        # and the fleet still works afterwards
+        self.drive_and_arrive(2.0, 0.0)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_follower", "formation_checks", FormationChecks, sys.argv)

@@ -1,0 +1,238 @@
+"""The coordinator's state machine without ROS: goals, forming, arrival, losses, rejoins, pauses,
+switches and refusals, driven with made-up poses."""
+import math
+
+import pytest
+
+from mbot_common.geometry import Pose2D, compose
+from mbot_follower.coordinator import (ABORTED, ARRIVED, DEGRADED, FORMING, IDLE, NAVIGATING, CoordinatorConfig,
+                                       FleetCoordinator, check_target)
+
+ROBOTS = ["leader", "follower_1", "follower_2"]
+
+
+def start_poses():
+    return {"leader": Pose2D(0.0, 0.0, 0.0), "follower_1": Pose2D(-1.0, 3.0, 0.0),
+            "follower_2": Pose2D(-1.5, -2.0, 0.5)}
+
+
+def at_slots(core, leader_pose):
+    """Every member exactly on its slot, facing the leader's way."""
+    poses = {}
+    for robot, (x, y) in core.assignment.slots.items():
+        p = compose(leader_pose, Pose2D(x, y, 0.0))
+        poses[robot] = Pose2D(p.x, p.y, leader_pose.theta)
+    return poses
+
+
+def heard(now, robots=ROBOTS):
+    return {r: now for r in robots}
+
+
+def make(formation="triangle", robots=ROBOTS):
+    return FleetCoordinator(robots, robots[0], formation, 2.5, CoordinatorConfig())
+
+
+def formed_and_navigating(core, t0=0.0):
+    """Goal to (5, 0), then the followers on their slots until NAVIGATING; returns (time, poses)."""
+    poses = start_poses()
+    ok, _, actions = core.set_goal(Pose2D(5.0, 0.0, 0.0), t0, poses)
+    assert ok and ("assignment",) in actions
+    t = t0
+    for _ in range(20):
+        t += 0.1
+        poses = at_slots(core, poses["leader"])
+        actions = core.update(t, poses, heard(t))
+        if core.phase == NAVIGATING:
+            return t, poses, actions
+    raise AssertionError("never left FORMING")
+
+
+def test_goal_forms_then_navigates_then_arrives():
+    core = make()
+    assert core.state() == IDLE
+    t, poses, actions = formed_and_navigating(core)
+    assert ("goal", "leader", Pose2D(5.0, 0.0, 0.0)) in actions
+    # The shape must hold stable_time (0.5 s) before the leader may go.
+    assert t == pytest.approx(0.6, abs=0.11)
+    leader = Pose2D(5.0, 0.0, 0.0)
+    for i in range(10):
+        t += 0.1
+        core.update(t, at_slots(core, leader), heard(t), leader_nav="SUCCEEDED")
+    assert core.state() == ARRIVED
+
+
+def test_forming_waits_while_a_follower_is_off_its_slot():
+    core = make()
+    poses = start_poses()
+    core.set_goal(Pose2D(5.0, 0.0, 0.0), 0.0, poses)
+    for i in range(30):
+        core.update(0.1 * (i + 1), poses, heard(0.1 * (i + 1)))
+    assert core.state() == FORMING
+    assert core.errors.edge_max > 0.3
+
+
+def test_slots_are_assigned_by_least_travel_and_leader_keeps_slot_zero():
+    core = make()
+    poses = start_poses()
+    core.set_goal(Pose2D(5.0, 0.0, 0.0), 0.0, poses)
+    slots = core.assignment.slots
+    assert slots["leader"] == (0.0, 0.0)
+    assert slots["follower_1"][1] > 0 > slots["follower_2"][1]  # the one on the left takes the left slot
+    assert core.assignment.follows["follower_1"] == "leader"
+
+
+@pytest.mark.parametrize("target, words", [
+    (Pose2D(float("nan"), 0.0, 0.0), "not a finite pose"),
+    (Pose2D(1.0, float("inf"), 0.0), "not a finite pose"),
+])
+def test_bad_targets_are_refused_and_nothing_changes(target, words):
+    core = make()
+    ok, message, actions = core.set_goal(target, 0.0, start_poses())
+    assert not ok and words in message and actions == []
+    assert core.state() == IDLE and core.target is None and words in core.reason
+
+
+class FakeFreeSpace(object):
+    """Free inside |x|, |y| < 10 except a wall at 2 < x < 3."""
+
+    def cell(self, x, y):
+        return (int(y), int(x)) if abs(x) < 10 and abs(y) < 10 else None
+
+    def is_free(self, x, y):
+        return self.cell(x, y) is not None and not 2 < x < 3
+
+
+def test_targets_in_walls_or_off_the_map_are_refused():
+    assert "off the map" in check_target(Pose2D(11.0, 0.0, 0.0), FakeFreeSpace())
+    assert "in a wall" in check_target(Pose2D(2.5, 0.0, 0.0), FakeFreeSpace())
+    assert check_target(Pose2D(5.0, 0.0, 0.0), FakeFreeSpace()) is None
+
+
+def test_unknown_formation_is_refused_and_the_assignment_stays():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    before = core.assignment
+    ok, message, actions = core.set_formation("hexagon", t, poses)
+    assert not ok and "hexagon" in message and actions == []
+    assert core.assignment is before and core.formation == "triangle" and core.state() == NAVIGATING
+
+
+def test_switch_while_moving_reassigns_and_measures_the_switch():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    ok, _, actions = core.set_formation("line", t, poses)
+    assert ok and actions == [("assignment",)]
+    assert core.formation == "line" and core.state() == NAVIGATING
+    assert all(abs(x) < 1e-9 for x, _ in core.assignment.slots.values())  # abreast: beside the leader
+    for i in range(10):
+        t += 0.1
+        core.update(t, at_slots(core, poses["leader"]), heard(t), leader_nav="ACTIVE")
+    switched = [e for e in core.events if e[1] == "switched"]
+    assert switched and "line reached" in switched[0][2]
+
+
+def test_a_silent_follower_is_lost_and_the_rest_replanned_then_it_rejoins():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    last = dict(heard(t))
+    # follower_1's controller stops: 1 s later it is lost
+    for i in range(12):
+        t += 0.1
+        last["leader"] = last["follower_2"] = t
+        actions = core.update(t, poses, last, leader_nav="ACTIVE")
+    assert core.state() == DEGRADED
+    assert core.lost == ["follower_1"] and "follower_1" not in core.assignment.slots
+    assert set(core.assignment.slots) == {"leader", "follower_2"}
+    lost_at = [e[0] for e in core.events if e[1] == "lost"][0]
+    assert lost_at - (t - 1.2) <= 1.05  # within loss_timeout of the last message
+    # it comes back
+    t += 0.1
+    core.update(t, poses, heard(t), leader_nav="ACTIVE")
+    assert core.lost == [] and core.state() == NAVIGATING
+    assert "follower_1" in core.assignment.slots
+
+
+def test_a_lost_leader_is_replaced_by_the_follower_nearest_its_slot():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    leader_pose = poses["leader"]
+    # follower_2 stands nearest to where the leader was
+    poses["follower_2"] = Pose2D(leader_pose.x - 0.5, leader_pose.y, 0.0)
+    last = heard(t)
+    actions = []
+    for i in range(12):
+        t += 0.1
+        last["follower_1"] = last["follower_2"] = t
+        actions += core.update(t, {r: p for r, p in poses.items() if r != "leader"}, last, leader_nav="ACTIVE")
+    assert core.leader == "follower_2"
+    assert ("goal", "follower_2", Pose2D(5.0, 0.0, 0.0)) in actions
+    assert core.assignment.leader == "follower_2" and core.assignment.slots["follower_2"] == (0.0, 0.0)
+
+
+def test_a_formation_that_no_longer_fits_falls_back():
+    robots = ["r0", "r1", "r2", "r3"]
+    core = FleetCoordinator(robots, "r0", "diamond", 2.0)
+    poses = {r: Pose2D(-i * 1.5, 0.0, 0.0) for i, r in enumerate(robots)}
+    core.set_goal(Pose2D(5.0, 0.0, 0.0), 0.0, poses)
+    last = heard(0.0, robots)
+    for i in range(12):
+        t = 0.1 * (i + 1)
+        for r in ("r0", "r1", "r2"):
+            last[r] = t
+        core.update(t, poses, last)
+    assert core.lost == ["r3"] and core.formation != "diamond"
+    assert len(core.assignment.slots) == 3 and "does not fit" in core.reason
+
+
+def test_an_obstacle_in_front_of_the_leader_pauses_then_resumes():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    actions = core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE", obstacle_ahead=True)
+    assert core.paused and ("cancel", "leader") in actions
+    t += 0.1
+    resumed = []
+    for i in range(12):
+        t += 0.1
+        resumed += core.update(t, poses, heard(t), leader_nav=None, obstacle_ahead=True)
+    assert not core.paused
+    assert ("goal", "leader", Pose2D(5.0, 0.0, 0.0)) in resumed
+    # within the cooldown the same obstacle does not pause the fleet again
+    assert not core.paused
+
+
+def test_the_leaders_navigation_giving_up_aborts_with_its_reason():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ABORTED: no path to the goal")
+    assert core.state() == ABORTED and "no path to the goal" in core.reason
+
+
+def test_arrival_waits_for_a_stable_shape_but_not_forever():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x + 2.0, poses["follower_1"].y, 0.0)
+    for i in range(50):
+        t += 0.1
+        core.update(t, off, heard(t), leader_nav="SUCCEEDED")
+    assert core.state() == NAVIGATING
+    t += core.config.arrive_timeout
+    core.update(t, off, heard(t), leader_nav="SUCCEEDED")
+    assert core.state() == ARRIVED and "not stable" in core.reason and "follower_1" in core.reason
+
+
+def test_unknown_leader_is_an_error():
+    with pytest.raises(ValueError, match="leader 'boss'"):
+        FleetCoordinator(ROBOTS, "boss", "triangle", 2.5)
+
+
+def test_slot_errors_report_distance_and_heading():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    moved = dict(poses)
+    p = poses["follower_1"]
+    moved["follower_1"] = Pose2D(p.x + 0.3, p.y + 0.4, math.radians(10))
+    errors = core.slot_errors(moved)
+    assert errors["follower_1"][0] == pytest.approx(0.5)
+    assert math.degrees(errors["follower_1"][1]) == pytest.approx(10.0)
