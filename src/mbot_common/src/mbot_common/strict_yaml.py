@@ -63,13 +63,13 @@ def convert(value, kind):
     """`value` as `kind` (float, int, bool, str, list, dict, or object = anything), or None
     when it is not one. float accepts an int but never a bool, a string or inf/NaN; int never
     accepts a bool."""
-    if kind not in KIND_NAMES:
-        raise TypeError("kind: expected one of float, int, bool, str, list, dict, object, got %r" % (kind,))
     result = _convert(value, kind)
     return None if result is _BAD else result
 
 
 def _convert(value, kind):
+    if kind not in KIND_NAMES:  # a programming error, not a config error
+        raise TypeError("kind: expected one of float, int, bool, str, list, dict, object, got %r" % (kind,))
     if kind is object:
         return value
     if kind is float:
@@ -191,7 +191,7 @@ class Reader(object):
                 self.fail(key, "missing key (required)")
             return default
         value = self.data[key]
-        result = _convert(value, kind) if kind in KIND_NAMES else convert(value, kind)  # TypeError
+        result = _convert(value, kind)
         if result is _BAD or (check is not None and not check(result)):
             self.expected(key, what or KIND_NAMES[kind], value)
         return result

@@ -1,0 +1,133 @@
+/**
+ * @file world_file.h
+ * @brief A world file (mbot_sim/WORLD_FORMAT.md) as plain structs, and its strict reader, which
+ *        also loads the world's map. Free of ROS types; the Python twin is mbot_common.world and
+ *        both pass the fixtures in test/fixtures/worlds with the same messages. Poses are
+ *        Pose2D {x [m], y [m], theta [rad]} in the map frame.
+ */
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mbot_common/geometry.h"
+#include "mbot_common/map_io.h"
+#include "mbot_common/strict_yaml.h"
+
+namespace mbot_common
+{
+/// @brief Raised for an invalid world file: `<file>: <key>: expected ..., got ...`.
+class WorldConfigError : public ConfigError
+{
+public:
+  using ConfigError::ConfigError;
+};
+
+/// @brief Shape of an obstacle: an upright box (length along its own x, width along y) or an
+///        upright cylinder.
+struct ShapeConfig
+{
+  enum class Type
+  {
+    BOX,
+    CYLINDER
+  };
+  Type type = Type::BOX;
+  double length = 0.0;  ///< box size along its x [m]
+  double width = 0.0;   ///< box size along its y [m]
+  double radius = 0.0;  ///< cylinder radius [m]
+};
+
+/// @brief One robot of the world file.
+struct RobotConfig
+{
+  std::string name;             ///< namespace and frame prefix
+  std::string model = "mbot";   ///< mbot_description model name
+  Pose2D pose;                  ///< start pose in the map frame
+  std::string key;              ///< where it came from in the file, e.g. "robots[1]" (for messages)
+};
+
+/// @brief A static box or cylinder besides the map walls.
+struct ObstacleConfig
+{
+  std::string name;  ///< unique; "obstacle_<i>" when the file gives none
+  ShapeConfig shape;
+  Pose2D pose;
+  std::string key;
+};
+
+/// @brief A kinematic body that follows waypoints (people, carts); robots cannot push it.
+struct MovingObstacleConfig
+{
+  enum class Mode
+  {
+    LOOP,      ///< after the last waypoint, back to the first
+    PING_PONG  ///< after the last waypoint, back along the same path
+  };
+  std::string name;  ///< unique; "moving_obstacle_<i>" when the file gives none
+  ShapeConfig shape;
+  std::vector<Point2D> waypoints;  ///< [m]; the first one is the start (at least 2)
+  double speed = 0.5;              ///< [m/s]
+  Mode mode = Mode::LOOP;
+  std::string key;
+};
+
+/// @brief Gaussian standard deviations of sensor noise (0 = none).
+struct NoiseConfig
+{
+  double laser_range = 0.0;   ///< [m] per beam
+  double odom_linear = 0.0;   ///< [m/s] on the measured linear velocity
+  double odom_angular = 0.0;  ///< [rad/s] on the measured angular velocity
+};
+
+/// @brief Faults of one robot (the fields of mbot_msgs/SetFault).
+struct FaultConfig
+{
+  double laser_dropout = 0.0;   ///< probability [0, 1] that a beam returns +Inf
+  double sensor_latency = 0.0;  ///< added delay of odom, scan, ground truth and joint states [s]
+  double sensor_jitter = 0.0;   ///< standard deviation of an extra random delay [s]
+  double odom_drift = 0.0;      ///< odometry heading drift [rad/s]
+  bool drive_frozen = false;    ///< motors fail: the robot ignores cmd_vel and stops
+  bool silenced = false;        ///< the robot stops publishing odom, scan, joint states and tf
+};
+
+/// @brief Faults given in the world file for the robot `robot`.
+struct RobotFaultConfig
+{
+  std::string robot;
+  FaultConfig faults;
+  std::string key;
+};
+
+/// @brief Everything a world file says. Paths are resolved relative to the world file.
+struct WorldConfig
+{
+  std::string file;                  ///< the world file as given (for messages)
+  std::string map;                   ///< the map entry as written in the file
+  std::string map_path;              ///< the map_server yaml: `map` relative to the world file's directory
+  OccupancyMap map_data;             ///< the loaded map
+  double physics_step = 0.01;        ///< [s]
+  double real_time_factor = 1.0;     ///< sim seconds per wall second; 0 = as fast as possible
+  unsigned seed = 0;                 ///< seed of every random draw
+  std::vector<RobotConfig> robots;
+  std::vector<ObstacleConfig> obstacles;
+  std::vector<MovingObstacleConfig> moving_obstacles;
+  NoiseConfig noise;
+  std::vector<RobotFaultConfig> faults;
+};
+
+/// @brief Read a world file strictly (WORLD_FORMAT.md) and load its map. Checks syntax, types,
+///        ranges, unique names and that faults name a robot of the file; not the geometry or the
+///        robot models (stage_node's World does that).
+/// @throws WorldConfigError `<file>: <key>: <problem>`; a map error is `<file>: map: <its message>`
+WorldConfig loadWorldConfig(const std::string& path);
+
+/// @brief Check a robot or body name: a ROS graph name segment (letters, digits, _; not starting
+///        with a digit). @return an empty string when valid, else what is wrong.
+std::string checkName(const std::string& name);
+
+/// @brief Check one robot's faults. @return an empty string when valid, else the problem with
+///        the field name, e.g. "laser_dropout: expected a probability in [0, 1], got 1.5".
+std::string checkFaults(const FaultConfig& faults);
+
+}  // namespace mbot_common
