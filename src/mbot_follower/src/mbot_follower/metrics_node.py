@@ -1,0 +1,208 @@
+"""Node ``metrics_collector``: the ROS side of the formation metrics (the numbers are metrics.py).
+
+Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts`` and per robot
+``/<ns>/base_pose_ground_truth`` (frame map), ``/<ns>/follower_controller/state``,
+``/<ns>/power`` and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
+robot that appears in an assignment (subscribed when it first appears).
+
+Outputs: ``/fleet/metrics`` (mbot_msgs/FleetMetrics, every ``~publish_period``, 1 s) and, when
+``~output_dir`` is not empty, metrics.csv, events.csv, controller.csv and metrics.json in it,
+every ``~write_period`` (5 s) and at shutdown, so that a killed run still leaves its files.
+
+Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~physics_step`` 0.01 s added to every
+latency (the simulator applies a command at its next step), ``~recovered_rms`` 0.15 m and
+``~recovered_hold`` 1 s (recovery after a loss), ``~robot_radius`` 0.15 m (clearance),
+``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s (see MetricsConfig).
+A message without a stamp (zero) counts at the time it arrives.
+"""
+import math
+import threading
+
+import rospy
+from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
+from nav_msgs.msg import Odometry, Path
+from std_msgs.msg import Float64
+
+from mbot_common.geometry import yaw_of
+from mbot_common.params import read_params
+from mbot_follower.fleet_io import assignment_from_msg
+from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter
+
+#: Node parameters that are not MetricsConfig fields: name -> (kind, default).
+NODE_PARAMS = {
+    "robots": (list, []),          # robot names; empty: every robot of an assignment
+    "output_dir": (str, ""),       # where the files go; empty: write nothing
+    "publish_period": (float, 1.0),  # /fleet/metrics period [s]
+    "write_period": (float, 5.0),    # files written this often [s]
+}
+
+
+def read_config():
+    """(MetricsConfig, node parameters) from the private parameters; ConfigError / ValueError
+    naming a parameter of the wrong type, an unknown one or a bad value."""
+    spec = dict(NODE_PARAMS)
+    spec.update({key: (float, value) for key, value in MetricsConfig().to_dict().items()})
+    values = read_params(rospy.get_param("~", {}), spec, rospy.get_name())
+    try:
+        config = MetricsConfig(**{key: values[key] for key in MetricsConfig().to_dict()})
+    except ValueError as error:
+        raise ValueError("%s: %s" % (rospy.get_name(), error))
+    for key in ("publish_period", "write_period"):
+        if not (math.isfinite(values[key]) and values[key] > 0.0):
+            raise ValueError("%s: %s: expected a number > 0 [s], got %r" % (rospy.get_name(), key, values[key]))
+    for name in values["robots"]:
+        if not isinstance(name, str) or not name or "/" in name:
+            raise ValueError("%s: robots: expected robot names (no slashes), got %r" % (rospy.get_name(), name))
+    return config, values
+
+
+def stamp_of(header):
+    """The message's sim time [s]; the arrival time if it carries no stamp."""
+    return header.stamp.to_sec() if not header.stamp.is_zero() else rospy.get_time()
+
+
+class MetricsNode(object):
+    def __init__(self, config, robots, output_dir):
+        self.collector = MetricsCollector(config)
+        self.writer = RunWriter(output_dir) if output_dir else None
+        self.fixed_robots = bool(robots)
+        self.lock = threading.Lock()   # the subscribers' threads and the timers share the collector
+        self.closed = False
+        self.subs = {}
+        self.pub = rospy.Publisher("/fleet/metrics", FleetMetrics, queue_size=1)
+        self.shared_subs = [
+            rospy.Subscriber("/fleet/assignment", FleetAssignment, self.on_assignment, queue_size=10),
+            rospy.Subscriber("/fleet/status", FleetStatus, self.on_status, queue_size=10),
+            rospy.Subscriber("/contacts", Contact, self.on_contact, queue_size=100),
+        ]
+        for robot in robots:
+            self.attach(robot)
+
+    def attach(self, robot):
+        if robot in self.subs:
+            return
+        rospy.loginfo("%s: measuring %s", rospy.get_name(), robot)
+        self.subs[robot] = [
+            rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth, robot, queue_size=200),
+            rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self.on_state, robot,
+                             queue_size=100),
+            rospy.Subscriber("/%s/power" % robot, Float64, self.on_power, robot, queue_size=100),
+            rospy.Subscriber("/%s/move_base/global_plan" % robot, Path, self.on_plan, robot, queue_size=5),
+        ]
+
+    # --- callbacks: convert the message, hand it to the collector ------------------------------
+
+    def on_assignment(self, msg):
+        assignment = assignment_from_msg(msg)
+        with self.lock:
+            if self.closed:
+                return
+            self.collector.on_assignment(stamp_of(msg.header), assignment)
+        if not self.fixed_robots:
+            for robot in [assignment.leader] + sorted(assignment.slots):
+                self.attach(robot)
+
+    def on_status(self, msg):
+        with self.lock:
+            if not self.closed:
+                self.collector.on_status(stamp_of(msg.header), msg.state, msg.reason, msg.lost)
+
+    def on_contact(self, msg):
+        with self.lock:
+            if not self.closed:
+                self.collector.on_contact(stamp_of(msg.header), msg.body_a, msg.body_b,
+                                          msg.position.x, msg.position.y)
+
+    def on_truth(self, msg, robot):
+        if msg.header.frame_id.lstrip("/") != "map":
+            rospy.logerr_throttle(10.0, "%s: /%s/base_pose_ground_truth: expected frame map, got %r; ignored"
+                                  % (rospy.get_name(), robot, msg.header.frame_id))
+            return
+        p = msg.pose.pose
+        try:
+            theta = yaw_of(p.orientation)
+        except ValueError as error:
+            rospy.logerr_throttle(10.0, "%s: /%s/base_pose_ground_truth: %s; ignored" % (rospy.get_name(), robot, error))
+            return
+        with self.lock:
+            if not self.closed:
+                self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta)
+
+    def on_state(self, msg, robot):
+        with self.lock:
+            if not self.closed:
+                self.collector.on_follower_state(robot, stamp_of(msg.header), msg.pose_stamp.to_sec(), msg.active,
+                                                 msg.lookups, msg.lookup_failures, msg.cycle_time, msg.mode)
+
+    def on_power(self, msg, robot):
+        with self.lock:
+            if not self.closed:
+                self.collector.on_power(robot, rospy.get_time(), msg.data)
+
+    def on_plan(self, msg, robot):
+        if msg.poses and msg.header.frame_id.lstrip("/") != "map":
+            rospy.logerr_throttle(10.0, "%s: /%s/move_base/global_plan: expected frame map, got %r; ignored"
+                                  % (rospy.get_name(), robot, msg.header.frame_id))
+            return
+        points = [(p.pose.position.x, p.pose.position.y) for p in msg.poses]
+        with self.lock:
+            if not self.closed:
+                self.collector.on_plan(robot, stamp_of(msg.header), points)
+
+    # --- outputs --------------------------------------------------------------------------------
+
+    def publish(self, _event=None):
+        with self.lock:
+            summary = self.collector.summary()
+            state = self.collector.state
+        fleet = summary["fleet"]
+
+        def number(key):
+            return float("nan") if fleet[key] is None else fleet[key]
+
+        msg = FleetMetrics()
+        msg.header.stamp = rospy.Time.now()
+        msg.state = state
+        msg.slot_rms = number("slot_rms_m")
+        msg.slot_max = number("slot_max_m")
+        msg.fit_rms = number("fit_rms_m")
+        msg.leader_lateral_error = number("leader_lateral_rms_m")
+        msg.latency_p95 = number("latency_p95_s")
+        msg.tf_success_rate = number("tf_success_rate")
+        msg.contacts = fleet["contacts"]
+        msg.min_clearance = number("min_clearance_m")
+        msg.energy = fleet["energy_j"]
+        msg.distance = fleet["distance_m"]
+        self.pub.publish(msg)
+
+    def save(self, _event=None):
+        if self.writer is None:
+            return
+        with self.lock:
+            self.writer.write(self.collector.run, self.collector.summary())
+
+    def finish(self):
+        """At shutdown: the last write, then no more messages."""
+        with self.lock:
+            if self.closed:
+                return
+            self.closed = True
+            if self.writer is not None:
+                self.writer.write(self.collector.run, self.collector.summary())
+                rospy.loginfo("%s: %d samples written to %s", rospy.get_name(), len(self.collector.run.samples),
+                              self.writer.output_dir)
+
+
+def main():
+    rospy.init_node("metrics_collector")
+    try:
+        config, params = read_config()
+        node = MetricsNode(config, params["robots"], params["output_dir"])
+    except (ValueError, OSError) as error:   # ConfigError is a ValueError
+        rospy.logfatal(str(error))
+        return 1
+    rospy.on_shutdown(node.finish)
+    rospy.Timer(rospy.Duration(params["publish_period"]), node.publish)
+    rospy.Timer(rospy.Duration(params["write_period"]), node.save)
+    rospy.spin()
+    return 0

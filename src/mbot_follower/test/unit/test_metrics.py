@@ -1,0 +1,340 @@
+"""The metrics collector measures the numbers it promises, on synthetic runs with known answers."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from mbot_follower.fleet_io import Assignment
+from mbot_follower.metrics import (MetricsCollector, MetricsConfig, RunFileError, RunWriter,
+                                   distance_to_polyline, load_run, main, summarize)
+
+GT_HZ = 50   # ground-truth rate of the simulator [Hz]
+WEDGE = {"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.5), "robot_2": (-1.0, -0.5)}
+
+
+def wedge(slots=None, formation="wedge"):
+    slots = slots or WEDGE
+    return Assignment("robot_0", formation, 1.0, dict(slots), {r: "robot_0" for r in slots})
+
+
+def drive(collector, t_from, t_to, poses, at=None):
+    """Feed every robot's ground truth at GT_HZ for t in [t_from, t_to): poses(t) -> {robot: (x, y, theta)}.
+    at(t), if given, runs first at every step (status, assignment, ... at that time)."""
+    for i in range(int(round(t_from * GT_HZ)), int(round(t_to * GT_HZ))):
+        t = i / float(GT_HZ)
+        if at is not None:
+            at(t)
+        for robot, (x, y, theta) in poses(t).items():
+            collector.on_pose(robot, t, x, y, theta)
+
+
+def near(t, when):
+    return abs(t - when) < 1e-9
+
+
+def test_slot_errors_rms_p95_max_per_follower_and_fleet():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge())
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    # The leader drives along x at 0.5 m/s; robot_1 is 0.1 m left of its slot all the time;
+    # robot_2's error grows 0.1 m per second (0.01 k at sample k).
+    drive(c, 0.0, 10.0, lambda t: {"robot_0": (0.5 * t, 0.0, 0.0),
+                                   "robot_1": (0.5 * t - 1.0, 0.6, 0.0),
+                                   "robot_2": (0.5 * t - 1.0, -0.5 - 0.1 * t, 0.0)})
+    s = summarize(c.run)
+    assert s["samples"] == 100                       # 0.0 .. 9.9 s at 10 Hz
+    r1, r2, fleet = s["robots"]["robot_1"], s["robots"]["robot_2"], s["fleet"]
+    assert r1["slot_rms_m"] == pytest.approx(0.1)
+    assert r1["slot_p95_m"] == pytest.approx(0.1)
+    assert r1["slot_max_m"] == pytest.approx(0.1)
+    e2 = [0.01 * k for k in range(100)]
+    assert r2["slot_rms_m"] == pytest.approx(math.sqrt(sum(e * e for e in e2) / 100))   # 0.5730
+    assert r2["slot_p95_m"] == pytest.approx(0.9405)  # between the 95th (0.94) and 96th (0.95) value
+    assert r2["slot_max_m"] == pytest.approx(0.99)
+    assert fleet["slot_rms_m"] == pytest.approx(math.sqrt((100 * 0.01 + sum(e * e for e in e2)) / 200))
+    assert fleet["slot_max_m"] == pytest.approx(0.99)
+    assert fleet["slot_samples"] == 200
+    assert s["robots"]["robot_0"]["slot_samples"] == 0   # the leader has no slot error
+    # A fit may move the shape, so it never explains less than the slots do.
+    assert r2["fit_rms_m"] < r2["slot_rms_m"]
+    # Distance: up to the last sample (9.9 s).
+    assert s["robots"]["robot_0"]["distance_m"] == pytest.approx(0.5 * 9.9)
+    assert s["robots"]["robot_2"]["distance_m"] == pytest.approx(math.hypot(0.5, 0.1) * 9.9)
+    assert fleet["time_in_state_s"] == {"NAVIGATING": pytest.approx(9.9)}
+
+
+def test_rotated_formation_has_plain_errors_but_no_fit_error():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge())
+    turn = math.radians(30.0)
+    rot = np.array([[math.cos(turn), -math.sin(turn)], [math.sin(turn), math.cos(turn)]])
+    lead = np.array([2.0, 1.0])
+    poses = {"robot_0": (2.0, 1.0, 0.0)}
+    for r in ("robot_1", "robot_2"):   # the whole shape turned by 30 deg about the leader
+        x, y = lead + rot @ np.array(WEDGE[r])
+        poses[r] = (x, y, turn)
+    drive(c, 0.0, 2.0, lambda t: poses)
+    s = summarize(c.run)
+    plain = 2.0 * math.hypot(1.0, 0.5) * math.sin(turn / 2.0)   # chord of a 30 deg turn: 0.5787 m
+    assert s["fleet"]["slot_rms_m"] == pytest.approx(plain)
+    assert s["fleet"]["slot_max_m"] == pytest.approx(plain)
+    assert s["fleet"]["fit_rms_m"] < 1e-9
+    assert s["fleet"]["fit_max_m"] < 1e-9
+    last = c.run.samples[-1]
+    assert last.edge_max < 1e-9
+    assert last.heading_max == pytest.approx(turn)
+
+
+def test_distance_to_polyline():
+    plan = [(0.0, 0.0), (5.0, 0.0), (5.0, 5.0)]
+    assert distance_to_polyline(2.0, 0.3, plan) == pytest.approx(0.3)
+    assert distance_to_polyline(6.0, 2.0, plan) == pytest.approx(1.0)
+    assert distance_to_polyline(6.0, -1.0, plan) == pytest.approx(math.sqrt(2.0))   # the corner
+    assert distance_to_polyline(-3.0, 4.0, plan) == pytest.approx(5.0)             # the start
+    assert distance_to_polyline(1.0, 1.0, [(1.0, 4.0)]) == pytest.approx(3.0)       # one point
+    assert distance_to_polyline(1.0, 1.0, [(0.0, 0.0), (0.0, 0.0), (2.0, 0.0)]) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="no points"):
+        distance_to_polyline(0.0, 0.0, [])
+
+
+def test_leader_lateral_error_counts_while_navigating_on_the_current_plan():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+    c.on_plan("robot_0", 0.0, [(0.0, 0.0), (5.0, 0.0), (5.0, 5.0)])
+    c.on_plan("robot_1", 0.0, [(0.0, 3.0), (5.0, 3.0)])   # not the leader's: never used
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+
+    def at(t):
+        if near(t, 4.0):
+            c.on_status(t, "ARRIVED", "at the target", [])
+
+    # 0.2 m left of the first leg for 2 s, 0.5 m for 2 s; then ARRIVED far away (not counted).
+    drive(c, 0.0, 6.0, lambda t: {"robot_0": (0.5 * t, 0.2 if t < 2.0 else 0.5, 0.0) if t < 4.0 else (9.0, 9.0, 0.0),
+                                  "robot_1": (0.5 * t - 1.0, 0.0, 0.0)}, at)
+    s = summarize(c.run)
+    assert s["fleet"]["leader_lateral_rms_m"] == pytest.approx(math.sqrt((0.2 ** 2 + 0.5 ** 2) / 2))
+    assert s["fleet"]["leader_lateral_max_m"] == pytest.approx(0.5)
+    assert c.run.samples[-1].leader_lateral == pytest.approx(math.hypot(4.0, 4.0))  # recorded, not counted
+    c.on_plan("robot_0", 6.0, [])   # an empty plan clears it
+    assert math.isnan(c.sample(6.0).leader_lateral)
+
+
+def test_latency_tf_success_rate_and_cycle_time():
+    c = MetricsCollector(MetricsConfig(physics_step=0.01))
+    for k in range(20):
+        t = 1.0 + 0.05 * k
+        age = 0.2 if k == 7 else 0.04          # one slow cycle
+        c.on_follower_state("robot_1", t, t - age, True, 10 * (k + 1), k // 4, 0.001 * (k + 1), "slot")
+    c.on_follower_state("robot_1", 2.0, 0.0, False, 200, 5, 0.0005, "idle")   # no pose: no latency
+    c.on_follower_state("robot_2", 2.0, 1.97, True, 100, 0, 0.002, "slot")
+    s = summarize(c.run)
+    r1 = s["robots"]["robot_1"]
+    assert r1["latency_p50_s"] == pytest.approx(0.05)        # 0.04 + one physics step
+    assert r1["latency_p95_s"] == pytest.approx(0.05 + 0.05 * 0.16)   # 19 x 0.05 and one 0.21
+    assert r1["latency_max_s"] == pytest.approx(0.21)
+    assert r1["tf_success_rate"] == pytest.approx(1.0 - 5.0 / 200.0)  # the newest counters
+    cycles_ms = [1.0 * (k + 1) for k in range(20)] + [0.5]
+    assert r1["cycle_time_p99_ms"] == pytest.approx(np.percentile(cycles_ms, 99))
+    assert r1["cycle_time_p99_ms"] == pytest.approx(19.8)
+    fleet = s["fleet"]
+    assert fleet["tf_success_rate"] == pytest.approx(1.0 - 5.0 / 300.0)
+    assert fleet["latency_max_s"] == pytest.approx(0.21)
+    assert s["robots"]["robot_2"]["latency_p50_s"] == pytest.approx(0.04)
+
+
+def loss_and_rejoin_run(config=None):
+    """robot_2 is lost at 5.0 s (DEGRADED at 5.3 s, re-planned: robot_1 must move 0.5 m to its new
+    slot, which takes it 2.5 s) and rejoins at 9.0 s. The leader stands at the origin."""
+    c = MetricsCollector(config)
+    c.on_assignment(0.0, wedge())
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    column = {"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}
+
+    def at(t):
+        if near(t, 5.0):
+            c.on_status(t, "NAVIGATING", "", ["robot_2"])
+        if near(t, 5.3):
+            c.on_status(t, "DEGRADED", "lost robot_2", ["robot_2"])
+            c.on_assignment(t, wedge(column, "column"))
+        if near(t, 9.0):
+            c.on_status(t, "NAVIGATING", "robot_2 rejoined", [])
+            c.on_assignment(t, wedge(dict(column, robot_2=(-2.0, 0.0)), "column"))
+
+    def poses(t):
+        y1 = 0.5 if t < 5.3 else max(0.0, 0.5 * (1.0 - (t - 5.3) / 2.5))
+        if t < 5.0:
+            p2 = (-1.0, -0.5, 0.0)
+        elif t < 9.0:
+            p2 = (-3.0, -3.0, 0.0)   # wandering while lost: far from any slot, must not count
+        else:
+            p2 = (-2.0, 0.0, 0.0)
+        return {"robot_0": (0.0, 0.0, 0.0), "robot_1": (-1.0, y1, 0.0), "robot_2": p2}
+
+    drive(c, 0.0, 10.0, poses, at)
+    return c
+
+
+def test_loss_recovery_time_to_degraded_and_exclusion_while_lost():
+    c = loss_and_rejoin_run()
+    s = summarize(c.run)
+    (rec,) = s["recoveries"]
+    assert rec["robot"] == "robot_2"
+    assert rec["t_s"] == pytest.approx(5.0)
+    assert rec["time_to_degraded_s"] == pytest.approx(0.3)
+    # robot_1's error 0.5 (1 - (t - 5.3) / 2.5) is under 0.15 m from t > 7.05 s: first sample 7.1 s.
+    assert rec["recovery_time_s"] == pytest.approx(2.1)
+    # robot_2 counts 5.0 s before the loss and 1.0 s after the rejoin, always in its slot.
+    assert s["robots"]["robot_2"]["slot_samples"] == 60
+    assert s["robots"]["robot_2"]["slot_max_m"] == pytest.approx(0.0)
+    assert s["fleet"]["slot_max_m"] == pytest.approx(0.5)
+    assert s["fleet"]["switches"] == 1
+    assert s["fleet"]["losses"] == 1 and s["fleet"]["rejoins"] == 1
+    assert s["fleet"]["time_in_state_s"]["DEGRADED"] == pytest.approx(3.7)
+    assert s["fleet"]["time_in_state_s"]["NAVIGATING"] == pytest.approx(5.3 + 0.9)
+    assert [e.kind for e in c.run.events] == ["assignment", "state", "loss", "state", "assignment",
+                                              "switch", "state", "rejoin", "assignment"]
+
+
+def test_recovery_needs_the_hold_and_an_already_degraded_fleet_takes_no_time():
+    # Needing 3 s under the bound, robot_1 (under it from 7.1 s) is never "recovered" before the
+    # run ends at 9.9 s (the window would need samples up to 10.1 s).
+    s = summarize(loss_and_rejoin_run(MetricsConfig(recovered_hold=3.0)).run)
+    assert s["recoveries"][0]["recovery_time_s"] is None
+    c = MetricsCollector()
+    c.on_status(1.0, "DEGRADED", "lost robot_3", ["robot_3"])
+    c.on_status(2.0, "DEGRADED", "lost robot_2 too", ["robot_3", "robot_2"])
+    rec = summarize(c.run)["recoveries"]
+    assert [(r["robot"], r["time_to_degraded_s"], r["recovery_time_s"]) for r in rec] == [
+        ("robot_3", 0.0, None), ("robot_2", 0.0, None)]
+
+
+def test_steady_rms_in_navigating_while_moving_and_in_arrived():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+
+    def at(t):
+        for when, state in ((0.0, "FORMING"), (2.0, "NAVIGATING"), (6.0, "ARRIVED")):
+            if near(t, when):
+                c.on_status(t, state, "", [])
+
+    def poses(t):
+        lx = 0.5 * min(max(t - 2.0, 0.0), 4.0)               # drives from 2 s to 6 s
+        error = 0.3 if t < 2.0 else (0.2 if t < 6.0 else 0.05)
+        return {"robot_0": (lx, 0.0, 0.0), "robot_1": (lx - 1.0, error, 0.0)}
+
+    drive(c, 0.0, 8.0, poses, at)
+    s = summarize(c.run)["fleet"]
+    assert s["steady_navigating_slot_rms_m"] == pytest.approx(0.2)
+    assert s["steady_arrived_slot_rms_m"] == pytest.approx(0.05)
+    assert s["slot_rms_m"] == pytest.approx(math.sqrt((20 * 0.09 + 40 * 0.04 + 20 * 0.05 ** 2) / 80))
+    assert s["time_in_state_s"] == {"FORMING": pytest.approx(2.0), "NAVIGATING": pytest.approx(4.0),
+                                    "ARRIVED": pytest.approx(1.9)}
+
+
+def test_clearance_contacts_and_stale_poses():
+    c = MetricsCollector(MetricsConfig(robot_radius=0.15))
+    c.on_pose("robot_3", 0.0, 0.0, 0.6, 0.0)   # heard once: stale after 1 s, then never counted
+
+    def at(t):
+        if near(t, 3.0):
+            c.on_contact(t, "robot_1", "map", 1.0, 2.0)
+        if near(t, 4.5):
+            c.on_contact(t, "robot_1", "box_1", 0.25, 0.5)
+
+    # robot_1 passes robot_2 0.5 m away at 4.0 s (clearance 0.5 - 2 x 0.15 = 0.2 m); it passes
+    # robot_3's old position 0.1 m away at the same time.
+    drive(c, 0.0, 8.0, lambda t: {"robot_1": (-2.0 + 0.5 * t, 0.5, 0.0), "robot_2": (0.0, 0.0, 0.0)}, at)
+    s = summarize(c.run)
+    assert s["fleet"]["min_clearance_m"] == pytest.approx(0.2)
+    assert s["fleet"]["min_clearance_t_s"] == pytest.approx(4.0)
+    assert s["fleet"]["min_clearance_pair"] == "robot_1 robot_2"
+    assert c.run.samples[5].min_clearance == pytest.approx(0.6 - 0.3)   # robot_3 still fresh at 0.5 s
+    assert s["fleet"]["contacts"] == 2
+    assert s["contact_list"] == [
+        {"t_s": 3.0, "body_a": "robot_1", "body_b": "map", "x_m": 1.0, "y_m": 2.0},
+        {"t_s": 4.5, "body_a": "robot_1", "body_b": "box_1", "x_m": 0.25, "y_m": 0.5}]
+    assert math.isnan(c.run.samples[-1].robots["robot_3"].x)
+
+
+def test_energy_integral_of_power_and_distance_without_teleports():
+    c = MetricsCollector(MetricsConfig(stale_after=1.0))
+
+    def at(t):
+        if t <= 10.0 and abs(t * 20 - round(t * 20)) < 1e-9:     # 20 Hz: 2 W, then 4 W from 5 s
+            c.on_power("robot_1", t, 2.0 if t < 5.0 else 4.0)
+        if near(t, 20.0):   # after a 10 s silence the last value holds for stale_after only
+            c.on_power("robot_1", t, 0.0)
+
+    def poses(t):
+        x = 0.5 * t if t < 12.0 else 0.5 * t + 10.0            # a 10 m teleport at 12 s
+        return {"robot_1": (x, 0.0, 0.0)}
+
+    drive(c, 0.0, 21.0, poses, at)
+    s = summarize(c.run)
+    assert c.energy["robot_1"] == pytest.approx(2.0 * 5.0 + 4.0 * 5.0 + 4.0 * 1.0)
+    assert s["robots"]["robot_1"]["energy_j"] == pytest.approx(34.0)   # the last sample is at 20.9 s
+    # The 0.02 s step with the teleport is not travel: 0.5 m/s x 20.9 s less 0.01 m.
+    assert s["robots"]["robot_1"]["distance_m"] == pytest.approx(0.5 * 20.9 - 0.01)
+    assert s["fleet"]["energy_j"] == pytest.approx(34.0)
+
+
+def test_files_read_back_into_the_same_run_and_summary(tmp_path):
+    c = loss_and_rejoin_run()
+    c.on_contact(6.0, "robot_1", "robot_0", -0.5, 0.1)
+    c.on_follower_state("robot_1", 6.0, 5.96, True, 40, 1, 0.0012, "slot")
+    writer = RunWriter(str(tmp_path / "run"))
+    writer.write(c.run, summarize(c.run))
+    # More samples and a robot that appears later (new columns): the files grow and stay whole.
+    c.on_assignment(10.0, wedge(dict(WEDGE, robot_9=(-2.0, 0.0)), "wedge"))
+    drive(c, 10.0, 11.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
+    c.on_follower_state("robot_9", 11.0, 10.9, True, 3, 0, 0.001, "slot")
+    live = summarize(c.run)
+    writer.write(c.run, live)
+
+    back = load_run(str(tmp_path / "run"))
+    assert back.robots == c.run.robots == ["robot_0", "robot_1", "robot_2", "robot_9"]
+    assert len(back.samples) == len(c.run.samples) == 110
+    assert "robot_9" not in back.samples[0].robots and "robot_9" in back.samples[-1].robots
+    # Compared as text: exact floats, and NaN (no data) reads back as NaN.
+    assert [str(s) for s in back.samples] == [str(s) for s in c.run.samples]
+    assert [str(e) for e in back.events] == [str(e) for e in c.run.events]
+    assert back.controller == c.run.controller
+    assert summarize(back) == live
+    with open(str(tmp_path / "run" / "metrics.json")) as f:
+        assert json.load(f) == live
+    assert live["fleet"]["contacts"] == 1 and live["robots"]["robot_9"]["slot_samples"] == 10
+    assert live["robots"]["robot_9"]["slot_rms_m"] == pytest.approx(0.1)
+
+
+def test_offline_main_prints_the_summary(tmp_path, capsys):
+    c = loss_and_rejoin_run()
+    RunWriter(str(tmp_path)).write(c.run, summarize(c.run))
+    assert main([str(tmp_path)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["recoveries"][0]["recovery_time_s"] == pytest.approx(2.1)
+
+
+def test_bad_config_and_bad_files_name_the_problem(tmp_path):
+    with pytest.raises(ValueError, match="rate: expected a finite number > 0, got 0"):
+        MetricsConfig(rate=0)
+    with pytest.raises(ValueError, match="robot_radius: .* got True"):
+        MetricsConfig(robot_radius=True)
+    with pytest.raises(RunFileError, match="metrics.csv: missing"):
+        load_run(str(tmp_path))
+    c = loss_and_rejoin_run()
+    RunWriter(str(tmp_path)).write(c.run, summarize(c.run))
+    path = tmp_path / "metrics.csv"
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(lines[:3] + [lines[3].replace("0.", "zero.", 1)] + lines[4:]) + "\n")
+    with pytest.raises(RunFileError, match=r"metrics.csv: line 4: t_s: expected a number, got 'zero.2'"):
+        load_run(str(tmp_path))
+    (tmp_path / "events.csv").write_text("t,kind\n")
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(RunFileError, match="events.csv: line 1: expected the columns t_s,kind,name"):
+        load_run(str(tmp_path))
+    (tmp_path / "metrics.json").write_text('{"config": {"rate": 10.0, "colour": 1}}')
+    with pytest.raises(RunFileError, match="metrics.json: config: unknown key.s. colour"):
+        load_run(str(tmp_path))
+    with pytest.raises(OSError, match="cannot create it"):
+        RunWriter(str(tmp_path / "metrics.csv" / "sub"))
