@@ -2,9 +2,13 @@
 
 When a formation is formed or switched, every follower may take any follower slot. Giving each
 robot the slot nearest to it one by one can send two robots across each other; the optimal
-assignment (the Hungarian method, `scipy.optimize.linear_sum_assignment`) minimises the sum of
-straight-line distances instead. The leader does not move to a slot: slot 0 is wherever it is.
-Pure numpy/scipy, no ROS.
+assignment (the Hungarian method, `scipy.optimize.linear_sum_assignment`) minimises the total
+travel instead. Travel is counted as the sum of SQUARED straight-line distances: with plain
+distances, robots side by side that switch to a column tie (either may take the rear slot), and
+the wrong choice makes a robot overtake another, which in a corridor it cannot. Squared
+distances break the tie the right way, and their optimum never has two straight paths crossing
+(the CAPT result of Turpin, Michael and Kumar). The leader does not move to a slot: slot 0 is
+wherever it is. Pure numpy/scipy, no ROS.
 """
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -25,7 +29,8 @@ def assign_slots(positions, slot_positions, leader_index=0):
 
     positions: (n, 2) world positions of the robots [m]; slot_positions: (n, 2) world positions
     of the slots [m], slot 0 = the leader's slot. Robot `leader_index` gets slot 0; the other
-    robots get slots 1..n-1 so that the sum of Euclidean distances robot -> slot is smallest.
+    robots get slots 1..n-1 so that the sum of squared distances robot -> slot is smallest
+    (travel_cost()).
     """
     robots = _as_points("positions", positions)
     slots = _as_points("slot_positions", slot_positions)
@@ -43,9 +48,9 @@ def assign_slots(positions, slot_positions, leader_index=0):
     slot_of = [0] * n
     followers = [i for i in range(n) if i != leader_index]
     if followers:
-        # cost[a, b]: distance of follower a to follower slot b + 1
+        # cost[a, b]: squared distance of follower a to follower slot b + 1
         diff = robots[followers][:, None, :] - slots[1:][None, :, :]
-        cost = np.hypot(diff[:, :, 0], diff[:, :, 1])
+        cost = diff[:, :, 0] ** 2 + diff[:, :, 1] ** 2
         rows, cols = linear_sum_assignment(cost)
         for a, b in zip(rows, cols):
             slot_of[followers[a]] = int(b) + 1
@@ -58,3 +63,10 @@ def total_travel(positions, slot_positions, slot_of):
     robots = _as_points("positions", positions)
     slots = _as_points("slot_positions", slot_positions)
     return float(sum(np.hypot(*(slots[s] - robots[i])) for i, s in enumerate(slot_of)))
+
+
+def travel_cost(positions, slot_positions, slot_of):
+    """What assign_slots() minimises: the sum of squared distances [m^2] robot -> slot."""
+    robots = _as_points("positions", positions)
+    slots = _as_points("slot_positions", slot_positions)
+    return float(sum(np.sum((slots[s] - robots[i]) ** 2) for i, s in enumerate(slot_of)))

@@ -4,7 +4,7 @@ States (``FleetStatus``)::
 
     IDLE --goal--> FORMING --shape reached--> NAVIGATING --leader at goal, shape stable--> ARRIVED
                       ^                            |
-                      +------- new goal -----------+--- leader's navigation gives up --> ABORTED
+                      +-- new goal, or switch -----+--- leader's navigation gives up --> ABORTED
 
     DEGRADED: a member is lost (no pose or, for a follower, no controller for ``loss_timeout``).
     The slots are re-planned for the robots left and the goal is kept: the fleet goes on forming
@@ -49,6 +49,8 @@ class CoordinatorConfig(object):
         self.pause_time = 1.0                      # obstacle in front of the leader: all stop this long [s]
         self.pause_cooldown = 5.0                  # no new pause this soon after one ends [s]
         self.topology = "star"                     # who follows whom: star or chain
+        self.hold_leader_on_switch = True          # a switch while navigating: the leader waits
+                                                   # (FORMING) until the new shape is reached
 
 
 def check_target(target, free_space=None):
@@ -144,9 +146,17 @@ class FleetCoordinator(object):
         self.formation, self.spacing = name, spacing
         self._switch_started = now
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
-        self.reason = "switching to %s" % name
+        actions = []
+        if self.phase == NAVIGATING and self.config.hold_leader_on_switch:
+            # Robots changing places while the leader drives on may meet a narrow passage
+            # before the new shape stands; the leader waits for it, then goes on.
+            actions.append(("cancel", self.leader))
+            self.paused = False
+            self._set_phase(FORMING, now, "switching to %s: the leader waits for the new shape" % name)
+        else:
+            self.reason = "switching to %s" % name
         return True, "switching to %s (%d robots, spacing %.2f m)" % (name, len(self.members), spacing), \
-            self._reassign(poses, now)
+            actions + self._reassign(poses, now)
 
     def _formation_problem(self, name, spacing):
         try:

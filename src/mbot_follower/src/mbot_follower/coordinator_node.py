@@ -227,11 +227,13 @@ class CoordinatorNode(object):
         poses = {}
         for robot in self.robots:
             try:
-                poses[robot], _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % robot, now_ros,
-                                              self.params["max_pose_age"])
-                self.last_heard_pose[robot] = now
+                # any age: the stamp says when the robot was last heard of (loss is 1 s without tf)
+                pose, stamp = lookup_pose(self.tf_buffer, "map", "%s/base_link" % robot, now_ros, float("inf"))
             except StalePose:
-                pass
+                continue
+            self.last_heard_pose[robot] = stamp.to_sec()
+            if now - stamp.to_sec() <= self.params["max_pose_age"]:
+                poses[robot] = pose
         with self.lock:
             self.poses = poses
             leader = self.core.leader

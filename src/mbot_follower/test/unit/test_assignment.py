@@ -1,11 +1,12 @@
-"""Slot assignment: the leader keeps slot 0, the followers travel least in total (= brute force)."""
+"""Slot assignment: the leader keeps slot 0, the followers travel least in total (= brute force
+over the squared distances that assign_slots minimises)."""
 import itertools
 import math
 
 import numpy as np
 import pytest
 
-from mbot_follower.assignment import assign_slots, total_travel
+from mbot_follower.assignment import assign_slots, total_travel, travel_cost
 
 
 def brute_force(positions, slots, leader):
@@ -16,7 +17,7 @@ def brute_force(positions, slots, leader):
         slot_of = [0] * len(positions)
         for robot, slot in zip(followers, perm):
             slot_of[robot] = slot
-        cost = total_travel(positions, slots, slot_of)
+        cost = travel_cost(positions, slots, slot_of)
         if cost < best:
             best, best_slot_of = cost, slot_of
     return best, best_slot_of
@@ -34,7 +35,7 @@ def test_equals_brute_force_on_random_cases(n):
         assert sorted(slot_of) == list(range(n))
         assert slot_of[leader] == 0
         best, best_slot_of = brute_force(positions, slots, leader)
-        assert total_travel(positions, slots, slot_of) == pytest.approx(best, abs=1e-9)
+        assert travel_cost(positions, slots, slot_of) == pytest.approx(best, abs=1e-9)
         assert slot_of == best_slot_of          # random reals: the optimum is unique
 
 
@@ -44,6 +45,17 @@ def test_crossing_paths_are_untangled():
     slots = [[0, 0], [-1.0, 1.0], [-1.0, -0.1]]
     assert assign_slots(positions, slots) == [0, 1, 2]
     assert total_travel(positions, slots, [0, 1, 2]) == pytest.approx(0.8 + 0.1)
+
+
+def test_side_by_side_robots_switching_to_a_column_keep_their_order():
+    # a diamond (leader, left, right, rear) switching to a column 1.5 m apart: with plain
+    # distances the rear slot ties between the two side robots; the squared cost gives it to the
+    # robot at the back, so nobody has to overtake anybody (in a corridor nobody could)
+    positions = [[0.0, 0.0], [-1.1, 1.1], [-1.1, -1.1], [-2.2, 0.0]]
+    slots = [[0.0, 0.0], [-1.5, 0.0], [-3.0, 0.0], [-4.5, 0.0]]
+    slot_of = assign_slots(positions, slots)
+    assert slot_of[3] == 3                      # the rear robot takes the rear slot
+    assert sorted(slot_of[1:3]) == [1, 2]
 
 
 def test_the_leader_keeps_slot_0_even_when_a_follower_is_nearer():
