@@ -1,0 +1,154 @@
+"""A client's view of a running formation fleet, for tests and benchmarks: it records every
+robot's ground truth from the simulator, the coordinator's status and assignment, contacts and
+the controllers' modes, sends targets and switches on the public topics, and waits for
+conditions in sim time (with a wall-clock bound, since at real_time_factor 0 sim time may race or
+stall). What it measures comes from the simulator, not from what the coordinator says of itself.
+"""
+import math
+import threading
+import time
+
+import rospy
+from geometry_msgs.msg import Pose2D as Pose2DMsg
+from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus, FollowerState
+from nav_msgs.msg import Odometry
+from std_msgs.msg import String
+
+from mbot_common.geometry import Pose2D, compose, yaw_of
+
+WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
+
+
+class FleetProbe(object):
+    """Records the fleet: ground truth of every robot, status, assignment, contacts."""
+
+    def __init__(self, robots):
+        self.lock = threading.Lock()
+        self.robots = robots
+        self.truth = {}        # robot -> (t, Pose2D, speed)
+        self.samples = []      # (t, state, {robot: Pose2D}, {robot: speed}, assignment)
+        self.status = None
+        self.states = []       # (t, state, reason)
+        self.assignment = None
+        self.contacts = []
+        for r in robots:
+            rospy.Subscriber("/%s/base_pose_ground_truth" % r, Odometry, self._on_truth, callback_args=r, queue_size=5)
+        rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=50)
+        rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=5)
+        rospy.Subscriber("/contacts", Contact, self._on_contact, queue_size=100)
+        self.target_pub = rospy.Publisher("/simulation/target_pose", Pose2DMsg, queue_size=1, latch=True)
+        self.formation_pub = rospy.Publisher("/fleet/formation", String, queue_size=1, latch=True)
+        self.modes = {}        # robot -> its follower controller's last mode
+        for r in robots:
+            rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState, self._on_follower, queue_size=5)
+        self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
+
+    def _on_follower(self, msg):
+        self.modes[msg.robot] = msg.mode
+
+    def _on_truth(self, msg, robot):
+        p = msg.pose.pose
+        v = msg.twist.twist.linear
+        with self.lock:
+            self.truth[robot] = (msg.header.stamp.to_sec(), Pose2D(p.position.x, p.position.y, yaw_of(p.orientation)),
+                                 math.hypot(v.x, v.y))
+
+    def _on_status(self, msg):
+        with self.lock:
+            if self.status is None or msg.state != self.status.state:
+                self.states.append((rospy.get_time(), msg.state, msg.reason))
+            self.status = msg
+
+    def _on_assignment(self, msg):
+        with self.lock:
+            self.assignment = msg
+
+    def _on_contact(self, msg):
+        with self.lock:
+            self.contacts.append(msg)
+
+    def _sample(self, _event):
+        with self.lock:
+            if self.status is None:
+                return
+            poses = {r: v[1] for r, v in self.truth.items()}
+            speeds = {r: v[2] for r, v in self.truth.items()}
+            self.samples.append((rospy.get_time(), self.status.state, poses, speeds, self.assignment))
+
+    # --- measures -----------------------------------------------------------------------------
+
+    @staticmethod
+    def slot_errors(poses, assignment):
+        """{follower: distance to its slot} from ground truth poses and an assignment message."""
+        if assignment is None or assignment.leader not in poses:
+            return {}
+        leader = poses[assignment.leader]
+        errors = {}
+        for s in assignment.slots:
+            if s.robot == assignment.leader or s.robot not in poses:
+                continue
+            slot = compose(leader, Pose2D(s.offset.x, s.offset.y, 0.0))
+            errors[s.robot] = math.hypot(poses[s.robot].x - slot.x, poses[s.robot].y - slot.y)
+        return errors
+
+    def state(self):
+        with self.lock:
+            return self.status.state if self.status else None
+
+    def wait(self, condition, sim_timeout, what):
+        """Wait until condition() (sim time, wall-bounded); fail naming `what` and the fleet's state."""
+        start = rospy.get_time()
+        wall_end = time.time() + WALL_LIMIT
+        while not rospy.is_shutdown() and time.time() < wall_end:
+            if condition():
+                return rospy.get_time()
+            if rospy.get_time() - start > sim_timeout:
+                break
+            time.sleep(0.01)
+        with self.lock:
+            s = self.status
+        raise AssertionError("timed out after %.0f s sim waiting for %s (fleet: %s, %s)\n%s" % (
+            rospy.get_time() - start, what, s.state if s else "no status", s.reason if s else "", self.describe()))
+
+    def describe(self):
+        """Where every robot is, its slot error and its controller's mode (for failure messages)."""
+        with self.lock:
+            poses = {r: v[1] for r, v in self.truth.items()}
+            errors = self.slot_errors(poses, self.assignment)
+            lines = ["formation %s, leader %s" % (self.assignment.formation, self.assignment.leader)
+                     if self.assignment else "no assignment"]
+            for r in sorted(poses):
+                lines.append("  %s at (%.2f, %.2f, %.0f deg), slot error %s, mode %s" % (
+                    r, poses[r].x, poses[r].y, math.degrees(poses[r].theta),
+                    "%.2f m" % errors[r] if r in errors else "-", self.modes.get(r, "?")))
+        return "\n".join(lines)
+
+    def wait_for_fleet(self, wall_timeout=120.0):
+        """Wait in wall time (at real_time_factor 0 sim time races ahead while the nodes start)
+        for the coordinator, every robot's ground truth, controller and move_base."""
+        from mbot_navigation.move_base_client import connect_move_base
+
+        heard = set()
+        subs = [rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
+                                 lambda msg, r=r: heard.add(r), queue_size=1) for r in self.robots]
+        end = time.time() + wall_timeout
+        while time.time() < end and not rospy.is_shutdown():
+            with self.lock:
+                ready = self.status is not None and len(self.truth) == len(self.robots) and len(heard) == len(self.robots)
+            if ready:
+                break
+            time.sleep(0.1)
+        for sub in subs:
+            sub.unregister()
+        if not ready:
+            raise AssertionError("fleet not up after %.0f s wall: status %s, ground truth of %s, controllers of %s" % (
+                wall_timeout, self.status is not None, sorted(self.truth), sorted(heard)))
+        for r in self.robots:
+            connect_move_base(r, max(1.0, end - time.time()))
+
+    def send_target(self, x, y, theta=0.0):
+        self.target_pub.publish(Pose2DMsg(x, y, theta))
+
+    def samples_in(self, states, since=0.0):
+        with self.lock:
+            return [s for s in self.samples if s[1] in states and s[0] >= since]
