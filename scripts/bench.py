@@ -4,7 +4,12 @@
     scripts/bench nav [--json FILE]   global plan time and length, DWA cycle time, and the
                                       seeded random-goal navigation trial in `office`
         --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 0: as fast as possible)
-    scripts/bench all [--json FILE]
+    scripts/bench formation [--json FILE] [--seeds N] [--sizes 3,5,10]
+                                      the formation fleet at real_time_factor 0 with lockstep:
+                                      convergence, straight and route slot error, switch time,
+                                      recovery after a loss, contacts, controller cycle time
+                                      (mbot_follower/formation_bench.py)
+    scripts/bench all [--json FILE]   sim and nav (the formation benchmark takes long: run it alone)
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
 Every program runs pinned to one core (taskset) so figures compare with single-threaded peers.
@@ -102,6 +107,15 @@ def bench_nav(trial_runs=100, trial_rtf=0.0):
     return result
 
 
+def bench_formation(seeds, sizes):
+    """The whole formation stack (many processes, so not pinned to one core); worst of the seeds."""
+    print("$ formation_bench --seeds %d --sizes %s --json" % (seeds, sizes), file=sys.stderr)
+    out = subprocess.run(["/usr/bin/python3", "-m", "mbot_follower.formation_bench", "--seeds", str(seeds),
+                          "--sizes", sizes, "--json"], check=True, stdout=subprocess.PIPE,
+                         universal_newlines=True).stdout
+    return json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
+
+
 def print_table(result):
     if "rtf" in result:
         print("\nSimulator (one core, as fast as possible, 360-beam 10 Hz lasers, 100 Hz physics)")
@@ -116,6 +130,21 @@ def print_table(result):
             print("  %-10s %8.2f %8.2f %12.1f %9d" % (n + "^2", r["p50"], r["p95"],
                                                      r["mean_path_cells"], r["failures"]))
         print("\nDWA cycle: p50 %.2f ms, p99 %.2f ms" % (result["dwa_ms"]["p50"], result["dwa_ms"]["p99"]))
+    if "formation" in result:
+        print("\nFormation (worst over seeds; targets: straight <= 0.05 m, route <= 0.15 m, converge <= 10 s,"
+              " switch <= 6 s, DEGRADED <= 2 s, re-converged <= 10 s, 0 contacts)")
+        print("  %-6s %9s %9s %11s %10s %11s %8s %10s %10s %9s %10s" % (
+            "robots", "succeeded", "contacts", "straight m", "route m", "converge s", "switch s",
+            "degraded s", "recover s", "cycle p99", "wall s"))
+        for n, r in result["formation"].items():
+            wall = max((d.get("wall_s") or 0) for d in r.get("details", [{}]))
+
+            def f(key, fmt):
+                return fmt % r[key] if r.get(key) is not None else "-"
+            print("  %-6s %9s %9d %11s %10s %11s %8s %10s %10s %9s %10.0f" % (
+                n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
+                f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
+                f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
     if "trial" in result:
         t = result["trial"]
         print("\nNavigation trial (office, real_time_factor %g): %d of %d goals reached, %d contacts, "
@@ -125,17 +154,21 @@ def print_table(result):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=["sim", "nav", "all"])
+    parser.add_argument("what", choices=["sim", "nav", "formation", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
     parser.add_argument("--trial-rtf", type=float, default=0.0,
                         help="real-time factor of the trial (default 0: as fast as possible, lockstep)")
+    parser.add_argument("--seeds", type=int, default=10, help="formation: seeds per fleet size")
+    parser.add_argument("--sizes", default="3,5,10", help="formation: fleet sizes")
     args = parser.parse_args(argv)
     result = {}
     if args.what in ("sim", "all"):
         result.update(bench_sim())
     if args.what in ("nav", "all"):
         result.update(bench_nav(args.trial_runs, args.trial_rtf))
+    if args.what == "formation":
+        result.update(bench_formation(args.seeds, args.sizes))
     result["machine"] = machine()
     print_table(result)
     if args.json:

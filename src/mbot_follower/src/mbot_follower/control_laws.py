@@ -75,6 +75,7 @@ class ControllerConfig(object):
         self.slot_tolerance = 0.05         # closer than this to a still slot = in the slot [m]
         self.safety_distance = 0.8         # stop if something is closer than this ahead [m]
         self.safety_half_angle = math.radians(30)  # half-width of "ahead" [rad]
+        self.safety_near_distance = 0.45   # stop if something is this close on the side it drives to [m]
         self.energy_k_v = 4.0              # power per speed^2 [W/(m/s)^2]
         self.energy_k_w = 0.5              # power per turn rate^2 [W/(rad/s)^2]
         self.omni = False                  # True: holonomic robot (uses vy)
@@ -95,6 +96,7 @@ class ControllerConfig(object):
         "slot_tolerance": (float, lambda v: v >= 0, ">= 0"),
         "safety_distance": (float, lambda v: v >= 0, ">= 0"),
         "safety_half_angle": (float, lambda v: 0 <= v <= math.pi, "in [0, pi] [rad]"),
+        "safety_near_distance": (float, lambda v: v >= 0, ">= 0"),
         "energy_k_v": (float, lambda v: v >= 0, ">= 0"),
         "energy_k_w": (float, lambda v: v >= 0, ">= 0"),
         "omni": (bool, None, None),
@@ -257,6 +259,22 @@ def safety_stop(ranges, angle_min, angle_increment, distance, half_angle):
         if r == float("-inf") or (math.isfinite(r) and r < distance):
             return True
     return False
+
+
+def safety_filter(cmd, ranges, angle_min, angle_increment, config):
+    """The safety layer, last in the loop: (cmd, stopped). The robot stops its travel (keeps
+    turning) when the laser sees something closer than `safety_distance` within
+    +-`safety_half_angle` of the direction it drives in (ahead, behind when backing up, sideways
+    for an omni robot), or closer than `safety_near_distance` anywhere on that side (+-90 deg),
+    which catches a robot coming in from the side."""
+    speed = math.hypot(cmd.vx, cmd.vy)
+    if speed < 1e-6:
+        return cmd, False
+    start = angle_min - math.atan2(cmd.vy, cmd.vx)   # beam angles relative to the travel direction
+    if safety_stop(ranges, start, angle_increment, config.safety_distance, config.safety_half_angle) or \
+            safety_stop(ranges, start, angle_increment, config.safety_near_distance, math.pi / 2):
+        return Twist2D(0.0, 0.0, cmd.wz), True
+    return cmd, False
 
 
 def energy_rate(cmd, k_v, k_w):

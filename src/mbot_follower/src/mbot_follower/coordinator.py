@@ -12,6 +12,13 @@ States (``FleetStatus``)::
     slot) or the fleet arrives. A lost leader is replaced by the follower nearest its slot, which
     takes over the leader's navigation goal.
 
+While NAVIGATING, the leader waits (its goal is cancelled and sent again) whenever a follower is
+more than ``regroup_error`` off its slot, until all are within ``resume_error``: after a sharp
+turn the slots swing faster than a follower can drive, and a fleet that drives on while its
+shape is broken is not a formation. Followers that follow the leader's trail past a wall, or
+that their safety layer holds (something in their way, e.g. a lost robot standing still), are
+excused: the leader's waiting would not bring them closer.
+
 A goal that cannot be reached as given (a NaN, off the map, in a wall) or an unknown formation
 is refused at once: the state does not change and the message says why.
 
@@ -48,6 +55,9 @@ class CoordinatorConfig(object):
         self.loss_timeout = 1.0                    # unheard this long = lost [s]
         self.pause_time = 1.0                      # obstacle in front of the leader: all stop this long [s]
         self.pause_cooldown = 5.0                  # no new pause this soon after one ends [s]
+        self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
+        self.resume_error = 0.15                   # ... until every follower is this close again [m]
+        self.regroup_timeout = 15.0                # ... or this long has passed [s]
         self.topology = "star"                     # who follows whom: star or chain
         self.hold_leader_on_switch = True          # a switch while navigating: the leader waits
                                                    # (FORMING) until the new shape is reached
@@ -97,6 +107,8 @@ class FleetCoordinator(object):
         self._switch_started = None
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
+        self._regroup_since = None           # the leader waits for the followers since then
+        self._no_regroup_before = -1e9
 
     # --- what the outside sees ----------------------------------------------------------------
 
@@ -167,7 +179,7 @@ class FleetCoordinator(object):
 
     # --- the cycle ----------------------------------------------------------------------------
 
-    def update(self, now, poses, last_heard, leader_nav=None, obstacle_ahead=False):
+    def update(self, now, poses, last_heard, leader_nav=None, obstacle_ahead=False, excused=()):
         """One coordinator cycle.
 
         :param now: sim time [s]
@@ -176,6 +188,8 @@ class FleetCoordinator(object):
         :param leader_nav: the leader's navigation: None (no goal), "ACTIVE", "SUCCEEDED" or
             "ABORTED: <why>"
         :param obstacle_ahead: something is close in front of the leader
+        :param excused: followers off their slot for a reason the leader's waiting would not cure
+            (following the leader's trail past a wall, held by their safety layer)
         :returns: list of actions (module docstring)
         """
         actions = self._losses_and_rejoins(now, poses, last_heard)
@@ -196,10 +210,10 @@ class FleetCoordinator(object):
                 self._leader_done_at = None
                 actions.append(("goal", self.leader, self.target))
         elif self.phase == NAVIGATING:
-            actions += self._navigating(now, poses, leader_nav, obstacle_ahead, stable)
+            actions += self._navigating(now, poses, leader_nav, obstacle_ahead, stable, excused)
         return actions
 
-    def _navigating(self, now, poses, leader_nav, obstacle_ahead, stable):
+    def _navigating(self, now, poses, leader_nav, obstacle_ahead, stable, excused):
         actions = []
         if self.paused:
             if now >= self._pause_until:
@@ -218,6 +232,10 @@ class FleetCoordinator(object):
         if leader_nav is not None and leader_nav.startswith("ABORTED"):
             self._set_phase(ABORTED, now, "the leader's navigation gave up: %s" % leader_nav[len("ABORTED"):].lstrip(": "))
             return actions
+        if self._leader_done_at is None and leader_nav != "SUCCEEDED":
+            regroup = self._regroup(now, poses, excused)
+            if regroup is not None:
+                return actions + regroup
         if leader_nav == "SUCCEEDED" and self._leader_done_at is None:
             self._leader_done_at = now
         if self._leader_done_at is not None:
@@ -227,6 +245,31 @@ class FleetCoordinator(object):
                 self._set_phase(ARRIVED, now, "the leader is at the target; formation not stable after %.0f s (%s)" % (
                     self.config.arrive_timeout, self._worst_follower(poses)))
         return actions
+
+    def _regroup(self, now, poses, excused):
+        """The leader waits while a follower is far off its slot (after a sharp turn, or when a
+        follower was held up) and drives on once all are close again. None: nothing to do;
+        else the actions (possibly none) of waiting."""
+        errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
+        worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
+        if self._regroup_since is None:
+            if worst is None or worst[1] <= self.config.regroup_error or now < self._no_regroup_before:
+                return None
+            self._regroup_since = now
+            self.reason = "regrouping: the leader waits for %s (%.2f m off its slot)" % worst
+            self.events.append((now, "regroup", self.reason))
+            return [("cancel", self.leader)]
+        timed_out = now - self._regroup_since > self.config.regroup_timeout
+        if worst is not None and worst[1] >= self.config.resume_error and not timed_out:
+            return []
+        self._regroup_since = None
+        if timed_out:
+            self._no_regroup_before = now + self.config.regroup_timeout
+        self.reason = "regrouped: driving on" if not timed_out else \
+            "driving on after %.0f s of regrouping (%s %.2f m off its slot)" % (
+                self.config.regroup_timeout, worst[0], worst[1])
+        self.events.append((now, "resume", self.reason))
+        return [("goal", self.leader, self.target)]
 
     # --- losses -------------------------------------------------------------------------------
 
@@ -361,6 +404,7 @@ class FleetCoordinator(object):
             self.events.append((now, "state", "%s -> %s" % (self.phase, phase)))
         self.phase = phase
         self._phase_since = now
+        self._regroup_since = None
         self.reason = reason
 
 

@@ -79,6 +79,7 @@ class CoordinatorNode(object):
         self.lock = threading.RLock()
         self.last_heard_pose = {}
         self.last_heard_controller = {}
+        self.controller_mode = {}
         self.poses = {}
         self.leader_scan = None
         self._scan_sub = None
@@ -204,6 +205,7 @@ class CoordinatorNode(object):
 
     def _on_controller(self, msg, robot):
         self.last_heard_controller[robot] = rospy.Time.now().to_sec()
+        self.controller_mode[robot] = msg.mode
 
     def _on_scan(self, msg):
         self.leader_scan = msg
@@ -249,7 +251,9 @@ class CoordinatorNode(object):
             scan = self.leader_scan
             obstacle = scan is not None and safety_stop(scan.ranges, scan.angle_min, scan.angle_increment,
                                                         self.params["pause_distance"], self.params["pause_half_angle"])
-            actions = self.core.update(now, poses, last_heard, self._leader_nav(), obstacle)
+            # followers off their slot for a reason the leader's waiting would not cure
+            excused = [r for r, mode in self.controller_mode.items() if mode in ("trail", "safety_stop")]
+            actions = self.core.update(now, poses, last_heard, self._leader_nav(), obstacle, excused)
             self._run(actions)
             self._publish_status()
             self.marker_pub.publish(markers.fleet_markers(self.core, poses, now_ros))

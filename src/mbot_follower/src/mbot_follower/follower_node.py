@@ -12,8 +12,9 @@ Every control period (sim time) it
    recent path (the trail) as far behind the leader as the slot is: a path the leader drove is
    free, and the follower rejoins its slot once the way is clear again;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
-   the command, and applies the safety layer first: anything closer than ``safety_distance`` in
-   the front +-``safety_half_angle`` stops the robot's forward motion;
+   the command, and gives the safety layer the last word (``safety_filter``): anything closer
+   than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or closer
+   than ``safety_near_distance`` on that side, stops the robot's travel;
 5. publishes ``cmd_vel``, ``power`` (the energy model's rate) and ``~state`` (FollowerState).
 
 While its robot leads (the assignment names it), the node publishes no command: the robot's
@@ -27,7 +28,7 @@ import rospy
 
 from mbot_common.geometry import Pose2D, Twist2D, compose, relative
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, energy_rate,
-                                        make_control_law, safety_stop)
+                                        make_control_law, safety_filter)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.trail import Trail
@@ -205,11 +206,12 @@ class FollowerController(object):
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
         # The safety layer has the last word: smoothing must not carry the robot on into something.
-        if self.scan is not None and safety_stop(self.scan.ranges, self.scan.angle_min, self.scan.angle_increment,
-                                                 self.config.safety_distance, self.config.safety_half_angle):
-            self.filter.reset()
-            cmd = Twist2D(0.0, 0.0, cmd.wz)
-            mode = "safety_stop"
+        if self.scan is not None:
+            cmd, stopped = safety_filter(cmd, self.scan.ranges, self.scan.angle_min, self.scan.angle_increment,
+                                         self.config)
+            if stopped:
+                self.filter.reset()
+                mode = "safety_stop"
         self._send(cmd)
         self._was_driving = True
         err = (slot[0] - pose.x, slot[1] - pose.y)

@@ -285,3 +285,26 @@ def test_main_runs_without_plotting(args, kind, capsys):
     assert out.startswith(kind)
     assert float(out.split("final RMS slot error")[1].split()[0]) < 0.01
     assert ("matplotlib.pyplot" in sys.modules) == had_pyplot
+
+
+@pytest.mark.parametrize("cmd, obstacle_at_deg, distance, stops", [
+    (Twist2D(0.3, 0.0, 0.2), 0, 0.7, True),        # ahead, inside 0.8 m
+    (Twist2D(0.3, 0.0, 0.2), 0, 0.9, False),       # ahead, beyond
+    (Twist2D(0.3, 0.0, 0.2), 180, 0.3, False),     # behind a robot driving forwards
+    (Twist2D(-0.1, 0.0, 0.0), 180, 0.7, True),     # behind a robot backing up
+    (Twist2D(0.3, 0.0, 0.0), 70, 0.4, True),       # close on the side it drives to
+    (Twist2D(0.3, 0.0, 0.0), 70, 0.6, False),      # beside, but not that close
+    (Twist2D(0.0, 0.3, 0.0), 90, 0.7, True),       # omni driving left, something left
+    (Twist2D(0.0, 0.0, 1.0), 0, 0.2, False),       # turning on the spot is never stopped
+])
+def test_safety_filter_looks_where_the_robot_drives(cmd, obstacle_at_deg, distance, stops):
+    from mbot_follower.control_laws import safety_filter
+    n = 360
+    ranges = [float("inf")] * n
+    ranges[(obstacle_at_deg + 180) % n] = distance           # beams from -pi, 1 deg apart
+    out, stopped = safety_filter(cmd, ranges, -math.pi, 2 * math.pi / n, ControllerConfig())
+    assert stopped == stops
+    if stops:
+        assert (out.vx, out.vy, out.wz) == (0.0, 0.0, cmd.wz)
+    else:
+        assert out == cmd

@@ -247,3 +247,38 @@ def test_slot_errors_report_distance_and_heading():
     errors = core.slot_errors(moved)
     assert errors["follower_1"][0] == pytest.approx(0.5)
     assert math.degrees(errors["follower_1"][1]) == pytest.approx(10.0)
+
+
+def test_the_leader_waits_for_a_follower_far_off_its_slot():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    p = poses["follower_1"]
+    off["follower_1"] = Pose2D(p.x - 1.0, p.y, p.theta)          # 1 m behind its slot
+    actions = core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE")
+    assert actions == [("cancel", "leader")] and "follower_1" in core.reason
+    assert core.state() == NAVIGATING and not core.paused         # the followers keep driving
+    off["follower_1"] = Pose2D(p.x - 0.4, p.y, p.theta)           # closer, but not close enough
+    assert core.update(t + 0.2, off, heard(t + 0.2), leader_nav=None) == []
+    actions = core.update(t + 0.3, poses, heard(t + 0.3), leader_nav=None)
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
+
+
+def test_a_follower_on_the_trail_does_not_hold_up_the_leader():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
+    assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1"]) == []
+
+
+def test_regrouping_gives_up_after_its_timeout():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_2"] = Pose2D(poses["follower_2"].x - 2.0, poses["follower_2"].y, 0.0)
+    core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE")
+    t += 0.1 + core.config.regroup_timeout + 0.1
+    actions = core.update(t, off, heard(t), leader_nav=None)
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "follower_2" in core.reason
+    assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == []   # not again at once

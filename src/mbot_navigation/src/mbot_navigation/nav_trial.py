@@ -133,28 +133,33 @@ def stop(process, log):
         process.wait()
 
 
+def wait_for_sim_time(name, launch_log, wall_timeout=60.0):
+    """rospy decides at init_node whether to use sim time: wait (wall time) until the launch has
+    set /use_sim_time on the master. RuntimeError pointing at `launch_log` when it does not."""
+    import rosgraph
+
+    master = rosgraph.Master("/" + name)
+    deadline = time.time() + wall_timeout
+    while True:
+        try:
+            if master.hasParam("/use_sim_time"):
+                return
+        except (OSError, rosgraph.MasterException):
+            pass  # the master is not up yet
+        if time.time() > deadline:
+            raise RuntimeError("no /use_sim_time from the launch after %.0f s (see %s)" % (wall_timeout, launch_log))
+        time.sleep(0.1)
+
+
 def drive(args, log):
     import rospy
     from actionlib_msgs.msg import GoalStatus
     from mbot_msgs.msg import Contact
     from nav_msgs.msg import OccupancyGrid, Odometry
 
-    import rosgraph
-
     from mbot_navigation.move_base_client import connect_move_base, make_goal
 
-    # rospy decides at init_node whether to use sim time: wait until roslaunch has set /use_sim_time.
-    master = rosgraph.Master("/nav_trial")
-    deadline = time.time() + 60.0
-    while True:
-        try:
-            if master.hasParam("/use_sim_time"):
-                break
-        except (OSError, rosgraph.MasterException):
-            pass  # the master is not up yet
-        if time.time() > deadline:
-            raise RuntimeError("no /use_sim_time from the launch after 60 s (see %s)" % args.launch_log)
-        time.sleep(0.1)
+    wait_for_sim_time("nav_trial", args.launch_log)
     rospy.init_node("nav_trial", disable_signals=True)
     robot = args.robot
     pose = []

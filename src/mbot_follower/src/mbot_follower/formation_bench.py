@@ -1,0 +1,268 @@
+"""Formation benchmark (``scripts/bench formation``): seeded runs of the whole stack at
+real_time_factor 0 with lockstep, for fleets of 3, 5 and 10 robots, measured from the
+simulator's ground truth.
+
+One run (one fleet size, one seed) in the empty 20 x 20 m room:
+
+1. the followers start at random places within 2 m of their slots (the seed draws them); the
+   fleet gets the target (3, 0): **converge_s** is the time in FORMING;
+2. the leader drives 9 m straight east: **rms_straight_m**, the followers' slot error RMS while
+   the leader moves (>= 0.1 m/s, from 3 s after it set off);
+3. at the target the formation switches to ``column``: **switch_s**, the time until every
+   follower is within 0.3 m of its new slot; then back to the first formation;
+4. a route with two 90 degree turns, (3, 6) then (-5, 6): **rms_route_m**, measured as in 2;
+5. on the way to (-5, 0) one follower's controller is killed: **degraded_s**, the time to
+   DEGRADED with the slots re-planned, and **recover_s**, until the others' slot error RMS stays
+   below 0.15 m for 1 s (timed from the kill);
+6. **contacts** (from the simulator) and **cycle_p99_ms** (the controllers' cycle time, wall)
+   from the metrics collector.
+
+The formation is ``diamond`` (``triangle`` for 3 robots: a diamond needs 4), spacing 1.5 m.
+A row of the table is the worst value over the seeds; ``succeeded`` counts runs in which every
+step finished (ARRIVED at every target, DEGRADED after the kill).
+
+The parent process runs one child process per run (rospy allows one node per process).
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from mbot_common.geometry import Pose2D, compose
+
+SIZES = (3, 5, 10)
+SPACING = 1.5               # [m]
+LEADER_START = (-6.0, 0.0)  # [m] in the empty room (walls at +-10 m); further east for deep formations
+START_RADIUS = 2.0          # [m] followers start within this of their slots
+MIN_GAP = 0.6               # [m] centre distance between any two starting robots
+ROOM = 9.0                  # [m] starting places stay within +-ROOM
+
+
+def formation_for(n):
+    return "triangle" if n < 4 else "diamond"
+
+
+def start_poses(n, seed):
+    """Seeded start poses [(name, Pose2D)]: the leader at LEADER_START facing east, each follower
+    within START_RADIUS of its slot, facing anywhere, no two closer than MIN_GAP."""
+    from mbot_follower.formations import make_formation
+
+    rng = np.random.RandomState(seed * 1000 + n)
+    offsets = make_formation(formation_for(n), n, SPACING).offsets
+    # a deep formation starts further east, so that its rear slots stay in the room
+    leader = Pose2D(max(LEADER_START[0], -ROOM + 0.5 - float(offsets[:, 0].min())), LEADER_START[1], 0.0)
+    poses = [("robot_0", leader)]
+    for i in range(1, n):
+        slot = compose(leader, Pose2D(offsets[i][0], offsets[i][1], 0.0))
+        for _ in range(1000):
+            r, a = START_RADIUS * math.sqrt(rng.uniform()), rng.uniform(-math.pi, math.pi)
+            x, y = slot.x + r * math.cos(a), slot.y + r * math.sin(a)
+            if abs(x) < ROOM and abs(y) < ROOM and all(math.hypot(x - p.x, y - p.y) >= MIN_GAP for _, p in poses):
+                break
+        else:
+            raise RuntimeError("no free start for robot %d of %d (seed %d)" % (i, n, seed))
+        poses.append(("robot_%d" % i, Pose2D(x, y, rng.uniform(-math.pi, math.pi))))
+    return poses
+
+
+def world_yaml(poses, map_path):
+    lines = ["# formation benchmark world (generated)", "map: %s" % map_path, "physics_step: 0.01",
+             "real_time_factor: 0.0", "seed: 1", "robots:"]
+    for name, p in poses:
+        lines += ["  - name: %s" % name, "    model: mbot", "    pose: [%.4f, %.4f, %.4f]" % (p.x, p.y, p.theta)]
+    return "\n".join(lines) + "\n"
+
+
+def worst(runs):
+    """One table row from the runs of a fleet size: worst value per measure, success counted."""
+    row = {"runs": len(runs), "succeeded": sum(1 for r in runs if r.get("succeeded")),
+           "contacts": sum(r.get("contacts", 0) for r in runs)}
+    for key in ("rms_straight_m", "rms_route_m", "converge_s", "switch_s", "degraded_s", "recover_s",
+                "cycle_p99_ms"):
+        values = [r[key] for r in runs if r.get(key) is not None]
+        row[key] = round(max(values), 4) if values else None
+    return row
+
+
+# --- one run (child process) -----------------------------------------------------------------
+
+def drive(n, seed, log):
+    """Play the steps of one run against the fleet already launched; returns the measures."""
+    import rospy
+    from std_msgs.msg import String
+
+    from mbot_follower.fleet_probe import FleetProbe
+
+    robots = ["robot_%d" % i for i in range(n)]
+    probe = FleetProbe(robots)
+    probe.wait_for_fleet(wall_timeout=300.0)
+    result = {"n": n, "seed": seed, "succeeded": False}
+    first = formation_for(n)
+
+    def arrive(x, y, theta, what):
+        probe.send_target(x, y, theta)
+        probe.wait(lambda: probe.state() in ("FORMING", "NAVIGATING"), 20.0, "%s to be taken" % what)
+        probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, what)
+        if probe.state() != "ARRIVED":
+            raise RuntimeError("%s: %s (%s)" % (what, probe.state(), probe.status.reason))
+
+    def moving_rms(since, until):
+        errors = []
+        for (t, _, poses, speeds, a) in probe.samples_in(("NAVIGATING", "DEGRADED"), since):
+            if t <= until and a is not None and speeds.get(a.leader, 0.0) >= 0.1:
+                errors += probe.slot_errors(poses, a).values()
+        return math.sqrt(sum(e * e for e in errors) / len(errors)) if errors else None
+
+    def formed(tolerance):
+        errors = probe.slot_errors({r: v[1] for r, v in probe.truth.items()}, probe.assignment)
+        return bool(errors) and max(errors.values()) < tolerance
+
+    def state_time(state, after):
+        return next(t for (t, s, _) in probe.states if s == state and t >= after)
+
+    # 1-2: converge from the random starts, then straight
+    t0 = rospy.get_time()
+    arrive(3.0, 0.0, 0.0, "the straight run")
+    t_nav = state_time("NAVIGATING", t0)
+    result["converge_s"] = round(t_nav - t0, 2)
+    result["rms_straight_m"] = moving_rms(t_nav + 3.0, rospy.get_time())
+    log("n=%d seed=%d: converged in %.1f s, straight RMS %.3f m" % (n, seed, result["converge_s"],
+                                                                      result["rms_straight_m"] or -1))
+    # 3: switch to a column and back
+    t_switch = rospy.get_time()
+    probe.formation_pub.publish(String("column"))
+    probe.wait(lambda: probe.assignment is not None and probe.assignment.formation == "column", 10.0, "column")
+    result["switch_s"] = round(probe.wait(lambda: formed(0.3), 60.0, "the column") - t_switch, 2)
+    probe.formation_pub.publish(String(first))
+    probe.wait(lambda: probe.assignment.formation == first, 10.0, first)
+    probe.wait(lambda: formed(0.3), 60.0, "the %s again" % first)
+    # 4: the route with two turns
+    t_route = rospy.get_time()
+    arrive(3.0, 6.0, math.pi / 2, "the route's first leg")
+    arrive(-5.0, 6.0, math.pi, "the route's second leg")
+    result["rms_route_m"] = moving_rms(t_route, rospy.get_time())
+    # 5: a follower's controller is killed on the way south
+    probe.send_target(-5.0, 0.0, -math.pi / 2)
+    probe.wait(lambda: probe.state() == "NAVIGATING" and probe.truth["robot_0"][1].y < 4.5, 120.0, "the last leg")
+    victim = sorted(s.robot for s in probe.assignment.slots if s.robot != probe.assignment.leader)[-1]
+    subprocess.check_call(["rosnode", "kill", "/%s/follower_controller" % victim],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    t_kill = rospy.get_time()
+    t_degraded = probe.wait(lambda: probe.state() == "DEGRADED" and victim not in
+                            [s.robot for s in probe.assignment.slots], 10.0, "DEGRADED")
+    result["degraded_s"] = round(t_degraded - t_kill, 2)
+    held = []
+
+    def reconverged():
+        poses = {r: v[1] for r, v in probe.truth.items() if r != victim}
+        errors = list(probe.slot_errors(poses, probe.assignment).values())
+        ok = bool(errors) and math.sqrt(sum(e * e for e in errors) / len(errors)) < 0.15
+        now = rospy.get_time()
+        if not ok:
+            del held[:]
+        elif not held:
+            held.append(now)
+        return ok and now - held[0] >= 1.0
+
+    result["recover_s"] = round(probe.wait(reconverged, 60.0, "re-converged") - 1.0 - t_kill, 2)
+    probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, "the last leg")
+    result["contacts"] = len(probe.contacts)
+    result["succeeded"] = probe.state() == "ARRIVED"
+    return result
+
+
+def run_one(n, seed, out_dir, log):
+    """Launch the fleet for (n, seed) on a private master, drive it, stop it. Returns measures."""
+    from mbot_common.paths import find_maps_directory
+    from mbot_navigation.nav_trial import free_port, stop, wait_for_sim_time
+
+    run_dir = os.path.join(out_dir, "n%d_seed%d" % (n, seed))
+    shutil.rmtree(run_dir, ignore_errors=True)
+    os.makedirs(run_dir)
+    world = os.path.join(run_dir, "world.yaml")
+    with open(world, "w") as f:
+        f.write(world_yaml(start_poses(n, seed), os.path.join(find_maps_directory(), "empty.yaml")))
+    port = free_port()
+    os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
+    os.environ.pop("ROS_IP", None)
+    launch_log = os.path.join(run_dir, "roslaunch.log")
+    cmd = ["roslaunch", "-p", str(port), "mbot_follower", "formation.launch", "world:=" + world,
+           "formation:=" + formation_for(n), "spacing:=%g" % SPACING, "real_time_factor:=0", "lockstep:=true",
+           "metrics_dir:=" + os.path.join(run_dir, "metrics")]
+    with open(launch_log, "w") as f:
+        process = subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+    result = {"n": n, "seed": seed, "succeeded": False}
+    try:
+        import rospy
+
+        wait_for_sim_time("formation_bench", launch_log, wall_timeout=120.0)
+        rospy.init_node("formation_bench", disable_signals=True)
+        started = time.time()
+        result = drive(n, seed, log)
+        result["wall_s"] = round(time.time() - started, 1)
+    except Exception as error:  # a failed run is a row of the table, not a crash of the benchmark
+        result["error"] = str(error).splitlines()[0]
+        log("n=%d seed=%d FAILED: %s" % (n, seed, str(error)))
+    finally:
+        stop(process, log)
+    metrics = os.path.join(run_dir, "metrics", "metrics.json")
+    if os.path.exists(metrics):
+        with open(metrics) as f:
+            fleet = json.load(f)["fleet"]
+        result["cycle_p99_ms"] = fleet.get("cycle_time_p99_ms")
+        result["contacts"] = max(result.get("contacts", 0), fleet.get("contacts") or 0)
+    return result
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(prog="formation_bench", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default=",".join(map(str, SIZES)), help="fleet sizes (default %(default)s)")
+    parser.add_argument("--seeds", type=int, default=10, help="seeds per size (default %(default)s)")
+    parser.add_argument("--first-seed", type=int, default=1)
+    parser.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "formation_bench"),
+                        help="run folders (world, launch log, metrics)")
+    parser.add_argument("--json", action="store_true", help="print the table as one JSON line")
+    parser.add_argument("--one", nargs=2, type=int, metavar=("N", "SEED"), help=argparse.SUPPRESS)
+    return parser.parse_args(argv)
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+
+    def log(message):
+        print("formation_bench: " + message, file=sys.stderr)
+        sys.stderr.flush()
+
+    if args.one:  # child: one run, its measures as the last line of stdout
+        print(json.dumps(run_one(args.one[0], args.one[1], args.out, log)))
+        return 0
+    table = {}
+    for n in [int(s) for s in args.sizes.split(",")]:
+        runs = []
+        for seed in range(args.first_seed, args.first_seed + args.seeds):
+            out = subprocess.run([sys.executable, "-m", "mbot_follower.formation_bench", "--one", str(n), str(seed),
+                                  "--out", args.out], stdout=subprocess.PIPE, universal_newlines=True)
+            lines = [l for l in out.stdout.splitlines() if l.startswith("{")]
+            run = json.loads(lines[-1]) if lines else {"n": n, "seed": seed, "succeeded": False,
+                                                        "error": "the run printed nothing (exit %d)" % out.returncode}
+            log("n=%d seed=%d: %s" % (n, seed, json.dumps(run)))
+            runs.append(run)
+        table[str(n)] = worst(runs)
+        table[str(n)]["details"] = runs
+    result = {"formation": table}
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(json.dumps(result, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
