@@ -9,6 +9,7 @@ numpy's legacy RandomState, whose stream numpy keeps frozen across versions).
 
 Maps (0.05 m per cell, map frame centred on the map, walls occupied, the rest free):
   empty          20 x 20 m room with walls
+  field          40 x 40 m room with walls (room for a fleet of ten in any formation; benchmarks)
   office         20 x 20 m: a 2 m corridor across, a 2 m corridor north, 4 rooms north,
                  a hall and a room south; doors 1.2 m wide
   cave           20 x 20 m of smooth irregular rock; every free cell can be reached by a robot
@@ -123,6 +124,12 @@ def make_empty():
     return grid
 
 
+def make_field():
+    grid = GridMap(40.0, 40.0, -20.0, -20.0)
+    grid.outer_walls()
+    return grid
+
+
 def make_office():
     grid = GridMap(20.0, 20.0, -10.0, -10.0)
     grid.outer_walls()
@@ -221,6 +228,7 @@ def make_bench_room_3x3():
 
 MAPS = [
     ("empty", make_empty, "20 x 20 m room with walls"),
+    ("field", make_field, "40 x 40 m room with walls (formation benchmark)"),
     ("office", make_office, "20 x 20 m office: corridors, rooms, 1.2 m doors"),
     ("cave", make_cave, "20 x 20 m cave with smooth irregular walls"),
     ("corridor", make_corridor, "30 x 8 m: a 1.5 m wide, 20 m long corridor between open areas"),

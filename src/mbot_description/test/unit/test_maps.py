@@ -14,7 +14,7 @@ from scipy import ndimage
 from paths import MAPS_DIR, MODELS, URDF_DIR
 
 MAIN_MAPS = ("empty", "office", "cave", "corridor", "warehouse")
-ALL_MAPS = MAIN_MAPS + ("bench_room", "bench_room_3x3")
+ALL_MAPS = MAIN_MAPS + ("bench_room", "bench_room_3x3", "field")
 WORLDS = MAIN_MAPS + ("bench_room",)
 CLEARANCE = 0.5       # [m] free space around each robot's footprint in a default world
 ROBOT_MARGIN = 0.05   # [m] beyond the footprint radius when asking whether a robot can pass

@@ -76,6 +76,10 @@ class ControllerConfig(object):
         self.safety_distance = 0.8         # stop if something is closer than this ahead [m]
         self.safety_half_angle = math.radians(30)  # half-width of "ahead" [rad]
         self.safety_near_distance = 0.45   # stop if something is this close on the side it drives to [m]
+        self.yield_after = 1.0             # held by the safety layer this long: give way [s]
+        self.yield_stagger = 0.5           # ... plus this per follower slot farther back than its own [s]
+        self.yield_time = 1.5              # how long to back away from what holds it [s]
+        self.yield_speed = 0.15            # how fast [m/s]
         self.energy_k_v = 4.0              # power per speed^2 [W/(m/s)^2]
         self.energy_k_w = 0.5              # power per turn rate^2 [W/(rad/s)^2]
         self.omni = False                  # True: holonomic robot (uses vy)
@@ -97,6 +101,10 @@ class ControllerConfig(object):
         "safety_distance": (float, lambda v: v >= 0, ">= 0"),
         "safety_half_angle": (float, lambda v: 0 <= v <= math.pi, "in [0, pi] [rad]"),
         "safety_near_distance": (float, lambda v: v >= 0, ">= 0"),
+        "yield_after": (float, lambda v: v >= 0, ">= 0"),
+        "yield_stagger": (float, lambda v: v >= 0, ">= 0"),
+        "yield_time": (float, lambda v: v >= 0, ">= 0"),
+        "yield_speed": (float, lambda v: v >= 0, ">= 0"),
         "energy_k_v": (float, lambda v: v >= 0, ">= 0"),
         "energy_k_w": (float, lambda v: v >= 0, ">= 0"),
         "omni": (bool, None, None),
@@ -275,6 +283,49 @@ def safety_filter(cmd, ranges, angle_min, angle_increment, config):
             safety_stop(ranges, start, angle_increment, config.safety_near_distance, math.pi / 2):
         return Twist2D(0.0, 0.0, cmd.wz), True
     return cmd, False
+
+
+class GiveWay(object):
+    """Breaks a standoff the safety layer cannot: two followers that want to pass each other
+    stop, each waiting for the other, for ever. A follower held for `yield_after` (+
+    `yield_stagger` for every follower slot farther from the leader than its own, so that the
+    one further back gives way first and the other can go) backs away from the nearest thing it
+    sees for `yield_time`, then drives on. Its commands still pass the safety layer."""
+
+    def __init__(self):
+        self.held_since = None    # when the safety layer started holding the robot [s]
+        self.until = None         # giving way until then [s]
+        self.cmd = None           # the command while giving way
+
+    def step(self, now, held, ranges, angle_min, angle_increment, rank, config):
+        """The command that gives way, or None to go on normally.
+
+        :param now: [s]; held: the safety layer stopped the last command
+        :param rank: how many follower slots lie farther from the leader than this robot's
+        """
+        if self.until is not None:
+            if now < self.until:
+                return self.cmd
+            self.until = None
+            self.held_since = None
+        if not held:
+            self.held_since = None
+            return None
+        if self.held_since is None:
+            self.held_since = now
+        if now - self.held_since < config.yield_after + config.yield_stagger * rank:
+            return None
+        nearest = min(((r, angle_min + i * angle_increment) for i, r in enumerate(ranges)
+                       if math.isfinite(r)), default=None)
+        if nearest is None:
+            return None
+        away = nearest[1] + math.pi
+        if config.omni:
+            self.cmd = Twist2D(config.yield_speed * math.cos(away), config.yield_speed * math.sin(away), 0.0)
+        else:  # along the body axis, away from it
+            self.cmd = Twist2D(config.yield_speed * (1.0 if math.cos(away) > 0 else -1.0), 0.0, 0.0)
+        self.until = now + config.yield_time
+        return self.cmd
 
 
 def energy_rate(cmd, k_v, k_w):

@@ -4,7 +4,7 @@ States (``FleetStatus``)::
 
     IDLE --goal--> FORMING --shape reached--> NAVIGATING --leader at goal, shape stable--> ARRIVED
                       ^                            |
-                      +-- new goal, or switch -----+--- leader's navigation gives up --> ABORTED
+                      +------- new goal -----------+--- leader's navigation gives up --> ABORTED
 
     DEGRADED: a member is lost (no pose or, for a follower, no controller for ``loss_timeout``).
     The slots are re-planned for the robots left and the goal is kept: the fleet goes on forming
@@ -14,8 +14,8 @@ States (``FleetStatus``)::
 
 While NAVIGATING, the leader waits (its goal is cancelled and sent again) whenever a follower is
 more than ``regroup_error`` off its slot, until all are within ``resume_error``: after a sharp
-turn the slots swing faster than a follower can drive, and a fleet that drives on while its
-shape is broken is not a formation. Followers that follow the leader's trail past a wall, or
+turn, or a formation switch on the move, the slots move faster than a follower can drive, and a
+fleet that drives on while its shape is broken is not a formation. Followers that follow the leader's trail past a wall, or
 that their safety layer holds (something in their way, e.g. a lost robot standing still), are
 excused: the leader's waiting would not bring them closer.
 
@@ -59,8 +59,6 @@ class CoordinatorConfig(object):
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
         self.topology = "star"                     # who follows whom: star or chain
-        self.hold_leader_on_switch = True          # a switch while navigating: the leader waits
-                                                   # (FORMING) until the new shape is reached
 
 
 def check_target(target, free_space=None):
@@ -158,17 +156,11 @@ class FleetCoordinator(object):
         self.formation, self.spacing = name, spacing
         self._switch_started = now
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
-        actions = []
-        if self.phase == NAVIGATING and self.config.hold_leader_on_switch:
-            # Robots changing places while the leader drives on may meet a narrow passage
-            # before the new shape stands; the leader waits for it, then goes on.
-            actions.append(("cancel", self.leader))
-            self.paused = False
-            self._set_phase(FORMING, now, "switching to %s: the leader waits for the new shape" % name)
-        else:
-            self.reason = "switching to %s" % name
+        # While navigating, the state stays NAVIGATING: when the robots changing places fall far
+        # behind their new slots, the leader waits for them (regrouping, see update()).
+        self.reason = "switching to %s" % name
         return True, "switching to %s (%d robots, spacing %.2f m)" % (name, len(self.members), spacing), \
-            actions + self._reassign(poses, now)
+            self._reassign(poses, now)
 
     def _formation_problem(self, name, spacing):
         try:

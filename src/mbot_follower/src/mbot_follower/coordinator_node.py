@@ -204,7 +204,7 @@ class CoordinatorNode(object):
             self.core.free_space = FreeSpace(grid, msg.info.resolution, origin, self.params["map_clearance"])
 
     def _on_controller(self, msg, robot):
-        self.last_heard_controller[robot] = rospy.Time.now().to_sec()
+        self.last_heard_controller[robot] = msg.header.stamp.to_sec()
         self.controller_mode[robot] = msg.mode
 
     def _on_scan(self, msg):
@@ -240,10 +240,12 @@ class CoordinatorNode(object):
             self.poses = poses
             leader = self.core.leader
             last_heard = {}
+            pose_lag = _lag(self.last_heard_pose, now)
+            controller_lag = _lag(self.last_heard_controller, now)
             for robot in self.robots:
-                heard = self.last_heard_pose.get(robot, -1e9)
+                heard = self.last_heard_pose.get(robot, -1e9) + pose_lag
                 if robot != leader:  # a follower also needs its controller
-                    heard = min(heard, self.last_heard_controller.get(robot, -1e9))
+                    heard = min(heard, self.last_heard_controller.get(robot, -1e9) + controller_lag)
                 last_heard[robot] = heard
             if not self._started(last_heard, now):
                 return
@@ -357,6 +359,13 @@ class CoordinatorNode(object):
             msg.rms_error, msg.max_error, msg.fit_rms_error = e.rms, e.max, e.fit_rms
             msg.edge_error, msg.heading_error = e.edge_max, e.heading_max
         self.status_pub.publish(msg)
+
+
+def _lag(stamps, now):
+    """How far a stream of stamped messages runs behind our clock: now minus its newest stamp.
+    A robot is lost when it falls silent while the others go on; a loaded machine that delivers
+    everybody's tf or heartbeats late must not make the coordinator count every robot lost."""
+    return max(0.0, now - max(stamps.values())) if stamps else 0.0
 
 
 def main():

@@ -1,9 +1,10 @@
 """What the follower controllers, the coordinator and the metrics collector share on the ROS side:
 the slot assignment as plain data and its message, and tf pose lookups that never wait.
 
-Why lookups never wait: under the simulator's lockstep, sim time stands still until every driven
-robot has sent its command. A lookup that waited in sim time (tf2's timeout) would hold the clock
-it waits for. So a lookup takes the newest transform and refuses it when it is older than a bound.
+Why lookups never wait in sim time: under the simulator's lockstep, sim time stands still until
+every driven robot has sent its command. A lookup that waited in sim time (tf2's timeout) would
+hold the clock it waits for. So a lookup takes the newest transform and refuses it when it is
+older than a bound, after polling for a newer one for a moment of wall time.
 """
 from collections import namedtuple
 
@@ -46,24 +47,33 @@ def assignment_to_msg(assignment, stamp):
     return msg
 
 
-def lookup_pose(buffer, target_frame, source_frame, now, max_age):
+def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0):
     """Pose of `source_frame` in `target_frame` from the newest transform in a tf2 Buffer.
 
     :param now: rospy.Time (sim time) the age is measured against
     :param max_age: [s] oldest acceptable transform
+    :param wall_wait: [s wall] how long to poll for a current transform when the newest is too
+        old. A loaded machine delivers /tf later than /clock; under lockstep sim time waits for
+        this node, so the transform is on its way. The wait is in wall time, never in sim time.
     :returns: (Pose2D, stamp)
     :raises StalePose: no transform, or the newest one is older than max_age
     """
+    import time
+
     import rospy
     import tf2_ros
 
-    try:
-        t = buffer.lookup_transform(target_frame, source_frame, rospy.Time(0))
-    except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as error:
-        raise StalePose("%s -> %s: %s" % (target_frame, source_frame, str(error).splitlines()[0]))
-    age = (now - t.header.stamp).to_sec()
-    if age > max_age:
-        raise StalePose("%s -> %s: newest transform is %.2f s old (limit %.2f s)" % (
-            target_frame, source_frame, age, max_age))
-    tr = t.transform.translation
-    return Pose2D(tr.x, tr.y, yaw_of(t.transform.rotation)), t.header.stamp
+    deadline = time.time() + wall_wait
+    while True:
+        try:
+            t = buffer.lookup_transform(target_frame, source_frame, rospy.Time(0))
+            age = (now - t.header.stamp).to_sec()
+            problem = None if age <= max_age else "newest transform is %.2f s old (limit %.2f s)" % (age, max_age)
+        except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as error:
+            problem = str(error).splitlines()[0]
+        if problem is None:
+            tr = t.transform.translation
+            return Pose2D(tr.x, tr.y, yaw_of(t.transform.rotation)), t.header.stamp
+        if time.time() >= deadline:
+            raise StalePose("%s -> %s: %s" % (target_frame, source_frame, problem))
+        time.sleep(0.002)

@@ -4,8 +4,9 @@ Every control period (sim time) it
 
 1. reads its private parameters again (every ``~param_refresh`` s), so ``rosparam set`` of a gain
    or limit takes effect without a restart;
-2. looks up its pose in the leader's frame from tf2 (``<leader>/base_link -> <ns>/base_link``);
-   a failed or stale lookup skips the control law and holds the robot still: it never acts on
+2. looks up its pose in the leader's frame from tf2 (``<leader>/base_link -> <ns>/base_link``),
+   polling up to ``~pose_wait`` of wall time for a transform at most ``~max_pose_age`` old; a
+   failed or stale lookup skips the control law and holds the robot still: it never acts on
    old data. Lookups and failures are counted and published;
 3. picks its target: its slot from ``/fleet/assignment``, or, when the slot or the straight way
    to it is blocked (a wall, its inflation, something the laser sees), a point on the leader's
@@ -27,7 +28,7 @@ import time
 import rospy
 
 from mbot_common.geometry import Pose2D, Twist2D, compose, relative
-from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, energy_rate,
+from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, energy_rate,
                                         make_control_law, safety_filter)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
 from mbot_follower.free_space import FreeSpace
@@ -37,6 +38,7 @@ from mbot_follower.trail import Trail
 NODE_PARAMS = {
     "rate": 20.0,             # control frequency [Hz sim time]
     "max_pose_age": 0.1,      # oldest tf pose the controller acts on [s]
+    "pose_wait": 0.1,         # how long to poll for a current pose before holding still [s wall]
     "controller": "slot_tracking",  # control law: slot_tracking or consensus
     "param_refresh": 0.5,     # how often the private parameters are read again [s sim time]
     "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
@@ -68,6 +70,8 @@ class FollowerController(object):
         self._read_params(startup=True)
         self.law = make_control_law(self.params["controller"])
         self.filter = CommandFilter(self.config)
+        self.give_way = GiveWay()
+        self._held = False
 
         self.assignment = None
         self.fleet_state = "IDLE"
@@ -184,10 +188,11 @@ class FollowerController(object):
         if reference not in a.slots:
             reference = a.leader
         age = self.params["max_pose_age"]
+        lookup_started = time.time()
         try:
             self.lookups += 1
             pose, stamp = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % self.robot,
-                                      now, age)
+                                      now, age, self.params["pose_wait"])
             ref_map, _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % reference, now, age)
             leader_map = ref_map if reference == a.leader else lookup_pose(
                 self.tf_buffer, "map", "%s/base_link" % a.leader, now, age)[0]
@@ -198,6 +203,7 @@ class FollowerController(object):
             self._publish_state(now, "no_pose", started)
             return
 
+        started += time.time() - lookup_started  # waiting for tf is not computing: not in cycle_time
         self.trail.add(leader_map.x, leader_map.y)
         slot = self._slot_relative_to(a, reference)
         target, mode = self._target(slot, pose, ref_map)
@@ -205,17 +211,25 @@ class FollowerController(object):
         twist = self.leader_twist if mode == "slot" else Twist2D(self.leader_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
-        # The safety layer has the last word: smoothing must not carry the robot on into something.
         if self.scan is not None:
-            cmd, stopped = safety_filter(cmd, self.scan.ranges, self.scan.angle_min, self.scan.angle_increment,
-                                         self.config)
-            if stopped:
+            scan = (self.scan.ranges, self.scan.angle_min, self.scan.angle_increment)
+            away = self.give_way.step(now.to_sec(), self._held, *scan, rank=self._rank(a, slot), config=self.config)
+            if away is not None:
+                cmd, mode = away, "give_way"
+            # The safety layer has the last word: smoothing must not carry the robot on into something.
+            cmd, self._held = safety_filter(cmd, *scan, config=self.config)
+            if self._held:
                 self.filter.reset()
                 mode = "safety_stop"
         self._send(cmd)
         self._was_driving = True
         err = (slot[0] - pose.x, slot[1] - pose.y)
         self._publish_state(now, mode, started, stamp, err, -pose.theta, cmd)
+
+    def _rank(self, a, slot):
+        """How many follower slots lie farther from the leader than this robot's (GiveWay)."""
+        mine = math.hypot(*a.slots[self.robot])
+        return sum(1 for r, s in a.slots.items() if r not in (self.robot, a.leader) and math.hypot(*s) > mine + 1e-6)
 
     def _slot_relative_to(self, a, reference):
         """The robot's slot seen from the robot it tracks (slots are given in the leader's frame;
@@ -297,7 +311,7 @@ class FollowerController(object):
         msg = self._msg["FollowerState"]()
         msg.header.stamp = now
         msg.robot = self.robot
-        msg.active = mode in ("slot", "trail", "safety_stop")
+        msg.active = mode in ("slot", "trail", "safety_stop", "give_way")
         msg.mode = mode
         if pose_stamp is not None:
             msg.pose_stamp = pose_stamp

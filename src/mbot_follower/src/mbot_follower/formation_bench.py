@@ -2,16 +2,18 @@
 real_time_factor 0 with lockstep, for fleets of 3, 5 and 10 robots, measured from the
 simulator's ground truth.
 
-One run (one fleet size, one seed) in the empty 20 x 20 m room:
+One run (one fleet size, one seed) in ``field``, an empty 40 x 40 m room:
 
-1. the followers start at random places within 2 m of their slots (the seed draws them); the
-   fleet gets the target (3, 0): **converge_s** is the time in FORMING;
-2. the leader drives 9 m straight east: **rms_straight_m**, the followers' slot error RMS while
-   the leader moves (>= 0.1 m/s, from 3 s after it set off);
-3. at the target the formation switches to ``column``: **switch_s**, the time until every
-   follower is within 0.3 m of its new slot; then back to the first formation;
-4. a route with two 90 degree turns, (3, 6) then (-5, 6): **rms_route_m**, measured as in 2;
-5. on the way to (-5, 0) one follower's controller is killed: **degraded_s**, the time to
+1. the followers start at random places within 2 m of their slots (the seed draws them), the
+   leader at (-14, -10) facing east; the fleet gets the target (4, -10): **converge_s** is the
+   time in FORMING;
+2. the leader drives east: **rms_straight_m**, the followers' slot error RMS while the leader
+   moves (>= 0.1 m/s), from 3 s after it set off until the switch;
+3. when the leader passes x = -2 the formation switches to ``column`` on the move:
+   **switch_s**, the time until every follower is within 0.3 m of its new slot;
+4. at the target the first formation again, then a route with two 90 degree turns, (4, 4) and
+   (-10, 4): **rms_route_m**, measured as in 2 over both legs;
+5. on the way to (-10, -6) one follower's controller is killed: **degraded_s**, the time to
    DEGRADED with the slots re-planned, and **recover_s**, until the others' slot error RMS stays
    below 0.15 m for 1 s (timed from the kill);
 6. **contacts** (from the simulator) and **cycle_p99_ms** (the controllers' cycle time, wall)
@@ -38,11 +40,12 @@ import numpy as np
 from mbot_common.geometry import Pose2D, compose
 
 SIZES = (3, 5, 10)
-SPACING = 1.5               # [m]
-LEADER_START = (-6.0, 0.0)  # [m] in the empty room (walls at +-10 m); further east for deep formations
-START_RADIUS = 2.0          # [m] followers start within this of their slots
-MIN_GAP = 0.6               # [m] centre distance between any two starting robots
-ROOM = 9.0                  # [m] starting places stay within +-ROOM
+SPACING = 1.5                  # [m]
+MAP = "field.yaml"             # 40 x 40 m, walls at +-20 m
+LEADER_START = (-14.0, -10.0)  # [m] facing east; further east for deep formations
+START_RADIUS = 2.0             # [m] followers start within this of their slots
+MIN_GAP = 0.6                  # [m] centre distance between any two starting robots
+ROOM = 19.0                    # [m] starting places stay within +-ROOM
 
 
 def formation_for(n):
@@ -127,30 +130,34 @@ def drive(n, seed, log):
     def state_time(state, after):
         return next(t for (t, s, _) in probe.states if s == state and t >= after)
 
-    # 1-2: converge from the random starts, then straight
+    # 1-2: converge from the random starts, then straight east
     t0 = rospy.get_time()
-    arrive(3.0, 0.0, 0.0, "the straight run")
-    t_nav = state_time("NAVIGATING", t0)
+    probe.send_target(4.0, -10.0, 0.0)
+    t_nav = probe.wait(lambda: probe.state() == "NAVIGATING", 120.0, "the end of FORMING")
     result["converge_s"] = round(t_nav - t0, 2)
+    probe.wait(lambda: probe.truth["robot_0"][1].x > -2.0, 300.0, "the leader at x = -2")
     result["rms_straight_m"] = moving_rms(t_nav + 3.0, rospy.get_time())
     log("n=%d seed=%d: converged in %.1f s, straight RMS %.3f m" % (n, seed, result["converge_s"],
                                                                       result["rms_straight_m"] or -1))
-    # 3: switch to a column and back
+    # 3: switch to a column on the move
     t_switch = rospy.get_time()
     probe.formation_pub.publish(String("column"))
     probe.wait(lambda: probe.assignment is not None and probe.assignment.formation == "column", 10.0, "column")
     result["switch_s"] = round(probe.wait(lambda: formed(0.3), 60.0, "the column") - t_switch, 2)
+    probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, "the straight run")
+    if probe.state() != "ARRIVED":
+        raise RuntimeError("the straight run: %s (%s)" % (probe.state(), probe.status.reason))
+    # 4: the first formation again, then the route with two turns
     probe.formation_pub.publish(String(first))
     probe.wait(lambda: probe.assignment.formation == first, 10.0, first)
     probe.wait(lambda: formed(0.3), 60.0, "the %s again" % first)
-    # 4: the route with two turns
     t_route = rospy.get_time()
-    arrive(3.0, 6.0, math.pi / 2, "the route's first leg")
-    arrive(-5.0, 6.0, math.pi, "the route's second leg")
+    arrive(4.0, 4.0, math.pi / 2, "the route's first leg")
+    arrive(-10.0, 4.0, math.pi, "the route's second leg")
     result["rms_route_m"] = moving_rms(t_route, rospy.get_time())
     # 5: a follower's controller is killed on the way south
-    probe.send_target(-5.0, 0.0, -math.pi / 2)
-    probe.wait(lambda: probe.state() == "NAVIGATING" and probe.truth["robot_0"][1].y < 4.5, 120.0, "the last leg")
+    probe.send_target(-10.0, -6.0, -math.pi / 2)
+    probe.wait(lambda: probe.state() == "NAVIGATING" and probe.truth["robot_0"][1].y < 2.0, 120.0, "the last leg")
     victim = sorted(s.robot for s in probe.assignment.slots if s.robot != probe.assignment.leader)[-1]
     subprocess.check_call(["rosnode", "kill", "/%s/follower_controller" % victim],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -188,7 +195,7 @@ def run_one(n, seed, out_dir, log):
     os.makedirs(run_dir)
     world = os.path.join(run_dir, "world.yaml")
     with open(world, "w") as f:
-        f.write(world_yaml(start_poses(n, seed), os.path.join(find_maps_directory(), "empty.yaml")))
+        f.write(world_yaml(start_poses(n, seed), os.path.join(find_maps_directory(), MAP)))
     port = free_port()
     os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
     os.environ.pop("ROS_IP", None)

@@ -308,3 +308,36 @@ def test_safety_filter_looks_where_the_robot_drives(cmd, obstacle_at_deg, distan
         assert (out.vx, out.vy, out.wz) == (0.0, 0.0, cmd.wz)
     else:
         assert out == cmd
+
+
+def test_give_way_backs_away_after_being_held_the_one_further_back_first():
+    from mbot_follower.control_laws import GiveWay
+    n = 360
+    ranges = [float("inf")] * n
+    ranges[180 + 20] = 0.4                       # something 20 deg left of ahead, 0.4 m away
+    scan = (ranges, -math.pi, 2 * math.pi / n)
+    config = ControllerConfig()
+    front, back = GiveWay(), GiveWay()           # rank 1: one slot lies farther back; rank 0: none
+    t = 0.0
+    assert front.step(t, True, *scan, rank=1, config=config) is None
+    assert back.step(t, True, *scan, rank=0, config=config) is None
+    t = 1.05                                     # after yield_after: only the one further back gives way
+    assert front.step(t, True, *scan, rank=1, config=config) is None
+    cmd = back.step(t, True, *scan, rank=0, config=config)
+    assert cmd == Twist2D(-config.yield_speed, 0.0, 0.0)        # backs away from what is ahead
+    assert back.step(t + 1.0, False, *scan, rank=0, config=config) == cmd   # for yield_time
+    assert back.step(t + config.yield_time + 0.01, False, *scan, rank=0, config=config) is None
+    assert front.step(t + 0.1, False, *scan, rank=1, config=config) is None  # freed: the clock restarts
+    assert front.step(1.6, True, *scan, rank=1, config=config) is None
+
+
+def test_give_way_of_an_omni_robot_moves_straight_away():
+    from mbot_follower.control_laws import GiveWay
+    n = 360
+    ranges = [float("inf")] * n
+    ranges[180 + 90] = 0.3                       # on its left
+    config = ControllerConfig(omni=True)
+    g = GiveWay()
+    g.step(0.0, True, ranges, -math.pi, 2 * math.pi / n, rank=0, config=config)
+    cmd = g.step(1.1, True, ranges, -math.pi, 2 * math.pi / n, rank=0, config=config)
+    assert cmd.vx == pytest.approx(0.0, abs=1e-9) and cmd.vy == pytest.approx(-config.yield_speed)

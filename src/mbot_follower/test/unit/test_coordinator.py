@@ -122,25 +122,20 @@ def test_switch_while_moving_reassigns_and_measures_the_switch():
     core = make()
     t, poses, _ = formed_and_navigating(core)
     ok, _, actions = core.set_formation("line", t, poses)
-    # the leader waits while the robots change places, then drives on
-    assert ok and actions == [("cancel", "leader"), ("assignment",)]
-    assert core.formation == "line" and core.state() == FORMING
+    assert ok and actions == [("assignment",)]
+    assert core.formation == "line" and core.state() == NAVIGATING
     assert all(abs(x) < 1e-9 for x, _ in core.assignment.slots.values())  # abreast: beside the leader
+    # the followers are now far from their new slots: the leader waits for them ...
+    actions = core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE")
+    assert actions == [("cancel", "leader")] and "regrouping" in core.reason
+    # ... and drives on once they are there
     resumed = []
     for i in range(10):
         t += 0.1
-        resumed += core.update(t, at_slots(core, poses["leader"]), heard(t), leader_nav=None)
+        resumed += core.update(t + 0.1, at_slots(core, poses["leader"]), heard(t + 0.1), leader_nav=None)
     switched = [e for e in core.events if e[1] == "switched"]
     assert switched and "line reached" in switched[0][2]
     assert core.state() == NAVIGATING and ("goal", "leader", Pose2D(5.0, 0.0, 0.0)) in resumed
-
-
-def test_switch_on_the_move_when_the_leader_need_not_wait():
-    core = make()
-    core.config.hold_leader_on_switch = False
-    t, poses, _ = formed_and_navigating(core)
-    ok, _, actions = core.set_formation("column", t, poses)
-    assert ok and actions == [("assignment",)] and core.state() == NAVIGATING
 
 
 def test_a_silent_follower_is_lost_and_the_rest_replanned_then_it_rejoins():
