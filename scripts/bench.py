@@ -23,7 +23,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SHARED_BENCH = os.path.join(os.path.dirname(ROOT), "shared", "bench", "planner")
+# The planner benchmark's inputs (shared with the peers we compare with; see its README).
+PLANNER_INPUTS = os.path.join(ROOT, "src", "mbot_navigation", "bench", "inputs")
 
 # Simulator benchmark plan: robots -> (map, sim seconds). The 1000-robot run uses the same room
 # tiled 3x3 (60x60 m). Sim seconds are chosen so that each run takes tens of wall seconds.
@@ -97,8 +98,8 @@ def bench_nav(trial_runs=100, trial_rtf=0.0):
     plan = {}
     for n in ("1000", "2000"):
         r = run_json([program("mbot_navigation", "plan_bench"),
-                      "--map", os.path.join(SHARED_BENCH, "map_%s.pgm" % n),
-                      "--pairs", os.path.join(SHARED_BENCH, "pairs_%s.csv" % n), "--json"])
+                      "--map", os.path.join(PLANNER_INPUTS, "map_%s.pgm" % n),
+                      "--pairs", os.path.join(PLANNER_INPUTS, "pairs_%s.csv" % n), "--json"])
         plan[n] = {k: r[k] for k in ("p50", "p95", "mean_path_cells", "failures")}
     dwa = run_json([program("mbot_navigation", "dwa_bench")])
     result = {"plan_ms": plan, "dwa_ms": {"p50": dwa["p50"], "p99": dwa["p99"]}}
@@ -124,7 +125,7 @@ def print_table(result):
             print("  %-8s %12.2f" % (n, x))
         print("  ray casting: %.1f million rays/s" % (result["rays_per_second"] / 1e6))
     if "plan_ms" in result:
-        print("\nGlobal planner (A*, shared inputs, planning only, one thread)")
+        print("\nGlobal planner (A*, the benchmark inputs, planning only, one thread)")
         print("  %-10s %8s %8s %12s %9s" % ("grid", "p50 ms", "p95 ms", "mean cells", "failures"))
         for n, r in result["plan_ms"].items():
             print("  %-10s %8.2f %8.2f %12.1f %9d" % (n + "^2", r["p50"], r["p95"],
