@@ -5,7 +5,7 @@ from the simulator's ground truth (not from what the coordinator says about itse
 
 The check is chosen by the private parameter ~check (one .test file per check):
   triangle  - the triangle drives to (5, 0) via /simulation/target_pose: slot RMS while moving
-              < 0.15 m, ARRIVED, no contact
+              < 0.15 m, ARRIVED, no contact (~formation, ~topology: another shape, a chain)
   obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
   switch    - switch to `line` while moving: the line is reached
   loss      - follower_1's controller is killed: DEGRADED within 1 s of the loss, the others ARRIVE
@@ -84,6 +84,11 @@ class FormationChecks(unittest.TestCase):
         p = self.probe
         self.assertEqual(p.state(), "IDLE")
         self.drive_and_arrive(5.0, 0.0)
+        self.assertEqual(p.assignment.formation, rospy.get_param("~formation", "triangle"))
+        if rospy.get_param("~topology", "star") == "chain":
+            # the last robot of the chain tracks the one ahead of it, not the leader
+            slots = sorted(p.assignment.slots, key=lambda s: math.hypot(s.offset.x, s.offset.y))
+            self.assertEqual(slots[-1].follows, slots[-2].robot)
         navigating = [s[0] for s in p.samples_in(("NAVIGATING",))]
         # steady: from 3 s after the leader set off (it accelerates, the followers catch up)
         rms = self.steady_rms(navigating[0] + 3.0)
