@@ -1,0 +1,172 @@
+"""The report's numbers (report_data) and plot helpers (report_plots) on plain data: criteria,
+slots of an assignment, speeds, what is better in a comparison, robot colours."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, assignment_at, assignments, \
+    compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, speeds, \
+    switch_settling
+from mbot_bringup.report_plots import error_limit, robot_colors, snapshot_indices
+from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize
+
+FIXTURE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "run_trio")
+NAN = float("nan")
+
+
+def test_assignments_are_read_from_the_collectors_events():
+    run = load_run(os.path.join(FIXTURE, "metrics"))
+    assigned = assignments(run)
+    assert [a.formation for a in assigned] == ["triangle", "triangle", "line", "line"]
+    assert assigned[0].leader == "leader"
+    assert assigned[0].slots["follower_1"] == (-2.16506, 1.25)
+    assert assigned[-1].slots == {"follower_1": (0.0, 2.5), "follower_2": (0.0, -2.5), "leader": (0.0, 0.0)}
+    assert assignment_at(assigned, 6171.44).formation == "triangle"
+    assert assignment_at(assigned, 6171.45).formation == "line"
+    assert assignment_at(assigned, 0.0) is None
+
+
+def test_an_unreadable_assignment_names_the_file_and_the_time():
+    run = Run()
+    run.events.append(Event(3.5, "assignment", "line", "slots everywhere", NAN, NAN))
+    with pytest.raises(ReportError, match=r"^x/events.csv: assignment at t = 3.50 s: expected"):
+        assignments(run, "x/events.csv")
+
+
+def test_slots_follow_the_leaders_pose():
+    run = Run()
+    run.events.append(Event(0.0, "assignment", "column", "leader L spacing 1 m slots L(0,0) a(-2,1)", NAN, NAN))
+    a = assignments(run)[0]
+    slots = slot_positions(a, (1.0, 2.0, math.pi / 2))   # leader at (1, 2) facing +y
+    assert list(slots) == ["a"]                          # the leader has no slot ring
+    assert slots["a"][0] == pytest.approx(0.0) and slots["a"][1] == pytest.approx(0.0)
+    assert slot_positions(a, (NAN, 0.0, 0.0)) == {}
+
+
+def test_criteria_pass_fail_and_missing_values():
+    numbers = {"steady_navigating_slot_rms_m": 0.15, "leader_lateral_rms_m": 0.081, "latency_p95_s": None,
+               "tf_success_rate": 0.99995, "contacts": 0, "arrived": False}
+    result = dict((c.name, c.passed) for c in evaluate(numbers, LabCriteria().criteria()))
+    assert result == {"steady_navigating_slot_rms_m": True, "leader_lateral_rms_m": False, "latency_p95_s": False,
+                      "tf_success_rate": True, "contacts": True, "arrived": False}
+
+
+def test_criteria_json_is_read_strictly():
+    good = {"scenario": "s", "passed": False, "facts": {"finished": True},
+            "criteria": [{"name": "contacts", "value": 2, "threshold": 0, "op": "<=", "passed": False}]}
+    assert parse_criteria(good, "c.json") == ("s", False, [Criterion("contacts", 2, "<=", 0, False)],
+                                              {"finished": True})
+    bad = [({"scenario": "s", "passed": True}, "c.json: criteria: missing"),
+           (dict(good, extra=1), "c.json: unknown key(s) extra"),
+           (dict(good, criteria=[{"name": "x", "value": 1, "op": "<="}]), "c.json: criteria[0]: expected the keys"),
+           (dict(good, criteria=[dict(good["criteria"][0], threshold="0")]),
+            'c.json: criteria[0].threshold: expected a number or true/false, got "0"'),
+           (dict(good, facts=[]), "c.json: facts: expected an object")]
+    for data, message in bad:
+        with pytest.raises(ReportError) as error:
+            parse_criteria(data, "c.json")
+        assert str(error.value).startswith(message)
+
+
+def test_values_are_shown_in_the_unit_of_the_table():
+    assert format_value("latency_p95_s", 0.1235) == "124"          # [ms]
+    assert format_value("tf_success_rate", 0.98765) == "98.765"    # [%]
+    assert format_value("steady_navigating_slot_rms_m", 0.12345) == "0.123"
+    assert format_value("arrived", True) == "yes"
+    assert format_value("leader_lateral_rms_m", None) == "-"
+    assert format_value("my_own_criterion", 2.5) == "2.5"
+
+
+def test_speed_over_a_window_removes_the_jitter_of_sampled_poses():
+    # 0.3 m/s along x, sampled at 10 Hz; each sample holds a pose up to 0.1 s old (as the
+    # collector's samples do when poses arrive late)
+    t = np.arange(0.0, 10.0, 0.1)
+    age = np.where(np.arange(len(t)) % 3 == 0, 0.1, 0.0)
+    x = 0.3 * (t - age)
+    short = speeds(t, x, np.zeros_like(t), 0.25, 1.0)            # over the neighbours: 0.2 s
+    smooth = speeds(t, x, np.zeros_like(t), 1.0, 1.0)
+    assert np.nanmax(np.abs(short[2:-2] - 0.3)) == pytest.approx(0.15)   # 0.15 or 0.45 m/s
+    assert np.nanmax(np.abs(smooth[6:-6] - 0.3)) < 0.035         # over 1 s: within ~10 %
+    gap = speeds([0.0, 0.1, 5.0, 5.1], [0.0, 0.03, 0.0, 0.03], [0.0] * 4, 1.0, 1.0)
+    assert math.isnan(gap[0]) is False and math.isnan(gap[2]) is False
+    assert gap[1] == pytest.approx(0.3) and gap[3] == pytest.approx(0.3)   # never across the 4.9 s gap
+
+
+def sample(t, state, slot_rms, leader_x=0.0):
+    robots = {"L": RobotSample(leader_x, 0.0, 0.0, NAN, NAN, leader_x, 0.0),
+              "f": RobotSample(leader_x - 1.0, 0.0, 0.0, slot_rms, slot_rms, leader_x, 0.0)}
+    return Sample(t, state, "L", "line", (), slot_rms, slot_rms, slot_rms, slot_rms, 0.0, 0.0, 0.0, 0.5, "L f",
+                  robots)
+
+
+def test_a_switch_settles_when_the_slot_rms_stays_under_the_recovery_bound():
+    run = Run()
+    run.robots = ["L", "f"]
+    rms = [0.05] * 10 + [1.0, 0.8, 0.5, 0.2, 0.1, 0.12, 0.3] + [0.1] * 12
+    run.samples = [sample(0.1 * k, "NAVIGATING", v) for k, v in enumerate(rms)]
+    run.events = [Event(0.0, "state", "NAVIGATING", "", NAN, NAN), Event(1.0, "switch", "line", "column", NAN, NAN)]
+    settled = switch_settling(run)
+    assert len(settled) == 1
+    # under 0.15 m from 1.7 s on for the 1 s hold (1.4 s is under, but 1.6 s is not)
+    assert run.samples[17].t == pytest.approx(1.7)
+    assert settled[0]["settle_s"] == pytest.approx(0.7)
+    assert settled[0]["peak_rms_m"] == 1.0
+    assert run_numbers(run, summarize(run))["switch_settle_max_s"] == pytest.approx(0.7)
+    assert [m.label for m in event_marks(run)] == ["switch column > line"]
+
+
+def test_compare_says_which_run_is_better():
+    a = {"slot_rms_m": 0.2, "tf_success_rate": 0.999, "latency_p95_s": 0.1, "arrived": True, "distance_m": 10.0}
+    b = {"slot_rms_m": 0.1, "tf_success_rate": 0.998, "latency_p95_s": 0.1002, "arrived": False, "distance_m": 12.0}
+    rows = dict((key, (diff, better)) for key, _, _, diff, better in compare_rows(a, b))
+    assert rows["slot_rms_m"] == (pytest.approx(-0.1), "B")          # lower is better
+    assert rows["tf_success_rate"] == (pytest.approx(-0.001), "A")   # higher is better
+    assert rows["latency_p95_s"][1] == "same"                         # 0.2 ms apart: the same when shown in ms
+    assert rows["arrived"] == (None, "A")
+    assert rows["distance_m"] == (pytest.approx(2.0), "")             # neither is better
+    assert "contacts" not in rows                                     # neither run has it
+
+
+def test_robots_have_the_colours_of_their_simulator_markers():
+    colors = robot_colors(["b", "a", "c", "new"], ["a", "b", "c"])
+    # /stage/markers: robot i of the world has hue i / 6: red, yellow, green (here 80 % as bright)
+    assert colors["a"] == pytest.approx((0.8, 0.2, 0.2))
+    assert colors["b"] == pytest.approx((0.6, 0.6, 0.0))
+    assert colors["c"] == pytest.approx((0.2, 0.8, 0.2))
+    assert colors["new"] == pytest.approx((0.0, 0.6, 0.6))          # the 4th: cyan
+    many = robot_colors(["r%d" % i for i in range(12)], [])
+    assert len(set(many.values())) == 12
+
+
+def test_error_axes_show_the_limit_and_the_typical_error():
+    assert error_limit(np.array([0.01, 0.02, NAN, 2.5]), 0.15) == pytest.approx(0.6)   # 4 x the limit
+    assert error_limit(np.array([1.0, 1.0, 1.2]), 0.15) == pytest.approx(1.5)         # 1.5 x the median
+    assert error_limit(np.array([0.2, 0.4]), None) == pytest.approx(0.45)
+
+
+def test_snapshots_fall_where_the_fleet_moves():
+    run = load_run(os.path.join(FIXTURE, "metrics"))
+    series = Series(run)
+    chosen = snapshot_indices(series, run)
+    times = [series.t[i] for i in chosen]
+    # the first samples after the target and the arrival (samples at 5 Hz, 0.05 s after the events)
+    assert times[0] == pytest.approx(0.15) and times[-1] == pytest.approx(51.75)
+    assert any(0.0 <= t - 19.0 < 0.2 for t in times)               # the switch (the first sample after it)
+    assert any(19.5 < t < 25.0 for t in times)                     # the followers moving out while the leader waits
+    assert 8 <= len(chosen) <= 13
+
+
+def test_events_to_mark_on_the_time_axes():
+    run = Run()
+    run.events = [Event(5.0, "contact", "follower_1", "map", 1.0, 2.0),
+                  Event(1.0, "state", "NAVIGATING", "formation reached", NAN, NAN),
+                  Event(2.0, "state", "FORMING", "paused: obstacle in front of the leader leader", NAN, NAN),
+                  Event(3.0, "loss", "follower_2", "", NAN, NAN),
+                  Event(4.0, "rejoin", "follower_2", "", NAN, NAN),
+                  Event(4.5, "assignment", "line", "leader L spacing 1 m slots L(0,0)", NAN, NAN),
+                  Event(6.0, "fault", "follower_1", "drive_frozen", NAN, NAN)]
+    assert [(m.t, m.kind, m.label) for m in event_marks(run)] == [
+        (2.0, "pause", "pause"), (3.0, "loss", "lost follower_2"), (4.0, "rejoin", "follower_2 back"),
+        (5.0, "contact", "contact follower_1-map"), (6.0, "fault", "fault follower_1")]

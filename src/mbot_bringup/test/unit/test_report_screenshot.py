@@ -1,0 +1,149 @@
+"""scripts/screenshot (rviz/fleet.rviz under Xvfb, captured by mbot_bringup.screenshot) of a
+running trio world: the PNG is not blank, and each robot's marker colour appears where the robot
+stands.
+
+Starts its own ROS master on a free port, the simulator (mbot_sim sim.launch world:=trio) and the
+map server (empty map), and stops them by PID at the end. Skips when ROS, Xvfb, rviz or
+ImageMagick's import is missing.
+
+Where a robot should appear: rviz's top-down view shows the map square (20 m x 20 m, walls and
+free cells in two greys) at 33 px/m (fleet.rviz "Scale"); its bounding box in the image gives the
+map frame, so robot (x, y) belongs at left + (x - x0) * s, bottom - (y - y0) * s.
+"""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from mbot_bringup.screenshot import looks_rendered
+from mbot_common.paths import resolve_world
+from mbot_common.world import load_world
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", "..", "..", ".."))
+NEEDED = ("roscore", "roslaunch", "rostopic", "Xvfb", "rviz", "import")
+MISSING = [p for p in NEEDED if shutil.which(p) is None]
+BACKGROUND = 48.0          # fleet.rviz "Background Color" 48; 48; 48
+MAP_ALPHA = 0.7            # fleet.rviz Map "Alpha"
+MARKER_ALPHA = 0.9         # stage_node's robot markers
+SCALE = 33.0               # fleet.rviz "Scale" [px/m]
+
+pytestmark = pytest.mark.skipif(bool(MISSING), reason="not installed: %s" % ", ".join(MISSING))
+
+
+def free_port():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def marker_rgb(index):
+    """The colour stage_node gives robot `index` of the world on /stage/markers (hue = index / 6)."""
+    import math
+    hue = (index % 6) / 6.0
+    return np.array([0.5 + 0.5 * math.cos(2.0 * math.pi * (hue - k / 3.0)) for k in range(3)]) * 255.0
+
+
+def stop(process):
+    """SIGINT (roslaunch and roscore shut their nodes down), then SIGKILL if it hangs."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+def wait_for(what, check, seconds):
+    end = time.time() + seconds
+    while time.time() < end:
+        if check():
+            return
+        time.sleep(0.5)
+    raise AssertionError("%s: not there after %d s" % (what, seconds))
+
+
+@pytest.fixture(scope="module")
+def trio_screenshot(tmp_path_factory):
+    """(path of the PNG, the trio world) of scripts/screenshot against a running trio world."""
+    tmp = tmp_path_factory.mktemp("screenshot")
+    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % free_port(), ROS_LOG_DIR=str(tmp / "logs"))
+    port = env["ROS_MASTER_URI"].rsplit(":", 1)[1]
+    world = load_world(resolve_world("trio"))
+    log = open(str(tmp / "ros.log"), "w")
+    processes = []
+    try:
+        processes.append(subprocess.Popen(["roscore", "-p", port], env=env, stdout=log, stderr=log))
+        wait_for("ROS master", lambda: subprocess.run(["rostopic", "list"], env=env, stdout=subprocess.DEVNULL,
+                                                      stderr=subprocess.DEVNULL).returncode == 0, 60)
+        processes.append(subprocess.Popen(["roslaunch", "mbot_sim", "sim.launch", "world:=trio"], env=env,
+                                          stdout=log, stderr=log))
+        processes.append(subprocess.Popen(["roslaunch", "mbot_navigation", "map_server.launch",
+                                           "map:=" + world.map_path], env=env, stdout=log, stderr=log))
+
+        def published():
+            out = subprocess.run(["rostopic", "list"], env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                 universal_newlines=True).stdout.split()
+            return "/stage/markers" in out and "/map" in out
+        wait_for("/stage/markers and /map", published, 120)
+        png = str(tmp / "trio.png")
+        shot = subprocess.run([os.path.join(ROOT, "scripts", "screenshot"), png, "--wait", "10"], env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=300)
+        assert shot.returncode == 0, shot.stdout
+        return png, world
+    finally:
+        for p in reversed(processes):
+            stop(p)
+        log.close()
+
+
+def map_box(image, map_data):
+    """(left, right, top, bottom) [px] of the map square: columns and rows where most pixels have
+    the colour of a free or an occupied cell under the map's alpha."""
+    free = MAP_ALPHA * 254.0 + (1 - MAP_ALPHA) * BACKGROUND
+    wall = (1 - MAP_ALPHA) * BACKGROUND
+    grey = (np.abs(image - image[..., :1]).max(axis=2) <= 2)
+    is_map = grey & ((np.abs(image[..., 0] - free) <= 3) | (np.abs(image[..., 0] - wall) <= 3))
+    cols = np.flatnonzero(is_map.sum(axis=0) > 0.5 * map_data.height * map_data.resolution * SCALE)
+    rows = np.flatnonzero(is_map.sum(axis=1) > 0.5 * map_data.width * map_data.resolution * SCALE)
+    return cols[0], cols[-1] + 1, rows[0], rows[-1] + 1
+
+
+def test_the_screenshot_is_rendered(trio_screenshot):
+    from PIL import Image
+    png, _ = trio_screenshot
+    assert looks_rendered(png)
+    image = Image.open(png).convert("RGB")
+    assert image.size == (1200, 846)                   # scripts/common.sh start_xvfb: 1200x846
+    assert len(image.getcolors(1 << 20)) > 100         # map, markers, panels, text
+
+
+def test_each_robots_colour_is_where_the_robot_is(trio_screenshot):
+    from PIL import Image
+    png, world = trio_screenshot
+    image = np.asarray(Image.open(png).convert("RGB"), dtype=float)
+    map_data = world.map_data
+    left, right, top, bottom = map_box(image, map_data)
+    scale = (right - left) / (map_data.width * map_data.resolution)
+    assert scale == pytest.approx(SCALE, rel=0.03)
+    assert (bottom - top) / (map_data.height * map_data.resolution) == pytest.approx(SCALE, rel=0.03)
+    x0, y0, _ = map_data.origin
+    free = MAP_ALPHA * 254.0 + (1 - MAP_ALPHA) * BACKGROUND
+    for index, robot in enumerate(world.robots):
+        colour = MARKER_ALPHA * marker_rgb(index) + (1 - MARKER_ALPHA) * free
+        rows, cols = np.nonzero(np.abs(image - colour).max(axis=2) <= 12)
+        assert len(rows) >= 15, "%s: its marker colour %s is not in the screenshot" % (robot.name, colour.round())
+        expected = (left + (robot.pose.x - x0) * scale, bottom - (robot.pose.y - y0) * scale)
+        found = (cols.mean(), rows.mean())
+        # within 0.1 m (the robot's radius is 0.15 m) of where the world file puts it
+        assert abs(found[0] - expected[0]) < 0.1 * scale and abs(found[1] - expected[1]) < 0.1 * scale, \
+            "%s at %s px, expected %s px" % (robot.name, np.round(found, 1), np.round(expected, 1))
+        assert cols.max() - cols.min() < 0.4 * scale      # one disc, not scattered pixels
