@@ -89,6 +89,7 @@ class CoordinatorNode(object):
         self._last_status = None
         self._last_debug = None
         self._startup_done = False
+        self._last_nav = None
         self._wall_start = time.time()
 
         self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
@@ -255,7 +256,11 @@ class CoordinatorNode(object):
                                                         self.params["pause_distance"], self.params["pause_half_angle"])
             # followers off their slot for a reason the leader's waiting would not cure
             excused = [r for r, mode in self.controller_mode.items() if mode in ("trail", "safety_stop")]
-            actions = self.core.update(now, poses, last_heard, self._leader_nav(), obstacle, excused)
+            nav = self._leader_nav()
+            if nav != self._last_nav:
+                rospy.loginfo("coordinator: %s's navigation: %s", leader, nav or "no goal")
+                self._last_nav = nav
+            actions = self.core.update(now, poses, last_heard, nav, obstacle, excused)
             self._run(actions)
             self._publish_status()
             self.marker_pub.publish(markers.fleet_markers(self.core, poses, now_ros))

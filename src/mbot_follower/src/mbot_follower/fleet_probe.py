@@ -39,12 +39,14 @@ class FleetProbe(object):
         self.target_pub = rospy.Publisher("/simulation/target_pose", Pose2DMsg, queue_size=1, latch=True)
         self.formation_pub = rospy.Publisher("/fleet/formation", String, queue_size=1, latch=True)
         self.modes = {}        # robot -> its follower controller's last mode
+        self.heartbeats = {}   # robot -> stamp of its controller's last state [s sim]
         for r in robots:
             rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState, self._on_follower, queue_size=5)
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
 
     def _on_follower(self, msg):
         self.modes[msg.robot] = msg.mode
+        self.heartbeats[msg.robot] = msg.header.stamp.to_sec()
 
     def _on_truth(self, msg, robot):
         p = msg.pose.pose
