@@ -88,6 +88,7 @@ class FleetCoordinator(object):
         self.members = list(robots)          # in the formation now
         self.lost = []                       # lost and not back
         self.formation = formation
+        self.requested_formation = formation  # what was asked for; a loss may force a fallback
         self.spacing = float(spacing)
         self.library.make(formation, len(self.members), self.spacing, topology=self.config.topology)  # validates
         self.phase = IDLE                    # what the fleet is doing; state() adds DEGRADED
@@ -130,6 +131,7 @@ class FleetCoordinator(object):
         if self.phase == NAVIGATING:
             actions.append(("cancel", self.leader))
         self.formation = formation or self.formation
+        self.requested_formation = self.formation
         self.spacing = spacing or self.spacing
         self.target = target
         self.paused = False
@@ -154,6 +156,7 @@ class FleetCoordinator(object):
             self.reason = "formation switch refused: " + problem
             return False, problem, []
         self.formation, self.spacing = name, spacing
+        self.requested_formation = name
         self._switch_started = now
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
         # While navigating, the state stays NAVIGATING: when the robots changing places fall far
@@ -297,10 +300,13 @@ class FleetCoordinator(object):
             words.append("%s rejoined" % ", ".join(back))
         if self.leader != old_leader:
             words.append("%s leads now" % self.leader)
-        if self._formation_problem(self.formation, self.spacing) is not None:
-            for name in FALLBACK_FORMATIONS:
+        if len(self.members) > 1:
+            # the formation asked for if it fits the robots there are now, else a fallback
+            for name in (self.requested_formation,) + FALLBACK_FORMATIONS:
                 if self._formation_problem(name, self.spacing) is None:
-                    words.append("%s does not fit %d robots: %s" % (self.formation, len(self.members), name))
+                    if name != self.requested_formation:
+                        words.append("%s does not fit %d robots: %s" % (self.requested_formation,
+                                                                      len(self.members), name))
                     self.formation = name
                     break
         self.reason = "; ".join(words)
@@ -325,6 +331,11 @@ class FleetCoordinator(object):
         if not all(r in poses for r in self.members):
             self.assignment = None
             return []
+        if len(self.members) == 1:  # the leader alone: no shape to keep
+            self.assignment = Assignment(self.leader, self.formation, self.spacing, {self.leader: (0.0, 0.0)},
+                                         {self.leader: ""})
+            self._stable_since = None
+            return [("assignment",)]
         formation = self.library.make(self.formation, len(self.members), self.spacing, topology=self.config.topology)
         order = [self.leader] + [r for r in self.members if r != self.leader]
         leader_pose = poses[self.leader]

@@ -224,7 +224,16 @@ class CoordinatorNode(object):
 
     # --- the cycle ----------------------------------------------------------------------------
 
-    def _cycle(self, _event):
+    def _cycle(self, event):
+        # rospy's timer thread dies with the first exception: a bug must cost one cycle, not the fleet
+        try:
+            self._step(event)
+        except Exception:  # noqa: B902 (logged with its traceback; the next cycle runs)
+            import traceback
+
+            rospy.logerr_throttle(5.0, "coordinator: cycle failed:\n%s" % traceback.format_exc())
+
+    def _step(self, _event):
         now_ros = rospy.Time.now()
         now = now_ros.to_sec()
         poses = {}
@@ -242,7 +251,8 @@ class CoordinatorNode(object):
             leader = self.core.leader
             last_heard = {}
             pose_lag = _lag(self.last_heard_pose, now)
-            controller_lag = _lag(self.last_heard_controller, now)
+            # the leader's own controller is idle and always quick: judge followers by followers
+            controller_lag = _lag({r: t for r, t in self.last_heard_controller.items() if r != leader}, now)
             for robot in self.robots:
                 heard = self.last_heard_pose.get(robot, -1e9) + pose_lag
                 if robot != leader:  # a follower also needs its controller

@@ -155,8 +155,8 @@ class FormationChecks(unittest.TestCase):
         p = self.probe
         p.send_target(5.0, 0.0)
         p.wait(lambda: p.state() == "NAVIGATING", 120.0, "NAVIGATING")
-        t_set = rospy.get_time()
         subprocess.check_call(["rosparam", "set", "/follower_1/follower_controller/max_linear_vel", "0.3"])
+        t_set = rospy.get_time()  # after: the parameter is set once the command returns
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED")
         after = [s for s in p.samples if s[0] >= t_set + 1.0]
         f1 = max(s[3].get("follower_1", 0.0) for s in after)

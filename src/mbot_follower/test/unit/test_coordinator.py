@@ -189,6 +189,8 @@ def test_a_formation_that_no_longer_fits_falls_back():
         core.update(t, poses, last)
     assert core.lost == ["r3"] and core.formation != "diamond"
     assert len(core.assignment.slots) == 3 and "does not fit" in core.reason
+    core.update(1.3, poses, heard(1.3, robots))           # r3 is back: the diamond again
+    assert core.formation == "diamond" and len(core.assignment.slots) == 4
 
 
 def test_an_obstacle_in_front_of_the_leader_pauses_then_resumes():
@@ -277,3 +279,18 @@ def test_regrouping_gives_up_after_its_timeout():
     actions = core.update(t, off, heard(t), leader_nav=None)
     assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "follower_2" in core.reason
     assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == []   # not again at once
+
+
+def test_the_leader_left_alone_keeps_its_goal_and_the_others_rejoin():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    last = heard(t)
+    for i in range(12):
+        t += 0.1
+        last["leader"] = t
+        core.update(t, poses, last, leader_nav="ACTIVE")
+    assert core.members == ["leader"] and core.state() == DEGRADED
+    assert core.assignment.slots == {"leader": (0.0, 0.0)}
+    core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE")
+    assert sorted(core.members) == sorted(ROBOTS) and core.formation == "triangle"
+    assert len(core.assignment.slots) == 3
