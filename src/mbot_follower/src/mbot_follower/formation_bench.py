@@ -162,8 +162,9 @@ def drive(n, seed, log):
     t_kill = rospy.get_time()  # before: sim time goes on while rosnode kill runs
     subprocess.check_call(["rosnode", "kill", "/%s/follower_controller" % victim],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    t_degraded = probe.wait(lambda: probe.state() == "DEGRADED" and victim not in
-                            [s.robot for s in probe.assignment.slots], 10.0, "DEGRADED")
+    # the loss shows in `lost` (the state may read ARRIVED if the leader got there meanwhile)
+    t_degraded = probe.wait(lambda: victim in probe.status.lost and victim not in
+                            [s.robot for s in probe.assignment.slots], 30.0, "DEGRADED")
     # the loss happened when the controller fell silent (sim time runs on while rosnode kill works)
     t_kill = max(t_kill, probe.heartbeats.get(victim, t_kill))
     result["degraded_s"] = round(t_degraded - t_kill, 2)
