@@ -1,17 +1,18 @@
 /**
  * @file robot_model.cpp
  * @brief Reads a robot's geometry from its URDF (urdfdom) and its limits and sensor settings from
- *        its model settings file (yaml-cpp). See robot_model.h.
+ *        its model settings file (mbot_common's strict YAML reader). See robot_model.h.
  */
 #include "mbot_description/robot_model.h"
 
+#include <mbot_common/strict_yaml.h>
 #include <urdf_parser/urdf_parser.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <set>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -48,173 +49,82 @@ std::string formatNumber(double value)
 // Model settings (yaml)
 // ---------------------------------------------------------------------------------------------
 
-/// Reads one settings file strictly: each map must hold exactly the expected keys and each value
-/// must have the expected type. Errors read "<file>: <key>: expected <what>, got <value>".
-class SettingsReader
+/// Reads one settings file strictly (mbot_common's reader): unknown, duplicate and missing keys
+/// and wrong types are errors "<file>: <key>: expected <what>, got <value>".
+using SettingsReader = mbot_common::StrictYaml<ModelError>;
+
+/// The number at `map[key]`; `where` is the map's key path ("" at the top level).
+double number(const SettingsReader& reader, const YAML::Node& map, const std::string& where,
+              const std::string& key, const std::string& unit)
 {
-public:
-  explicit SettingsReader(std::string file) : file_(std::move(file)) {}
+  return reader.number(map[key], SettingsReader::join(where, key), "a number " + unit);
+}
 
-  YAML::Node load() const
-  {
-    const std::string text = readFile(file_, "model settings file");
-    YAML::Node root;
-    try
-    {
-      root = YAML::Load(text);
-    }
-    catch (const YAML::Exception& e)
-    {
-      throw ModelError(file_ + ": not valid YAML: " + e.what());
-    }
-    if (!root.IsMap()) fail("(top level)", "expected a map of settings", root);
-    return root;
-  }
+int integer(const SettingsReader& reader, const YAML::Node& map, const std::string& where,
+            const std::string& key)
+{
+  const std::string path = SettingsReader::join(where, key);
+  const long long value = reader.integer(map[key], path);
+  if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max())
+    reader.expected(path, "an integer", map[key]);
+  return static_cast<int>(value);
+}
 
-  [[noreturn]] void fail(const std::string& key, const std::string& expected,
-                         const YAML::Node& got) const
-  {
-    throw ModelError(file_ + ": " + key + ": " + expected + ", got " + describe(got));
-  }
+std::vector<std::string> textList(const SettingsReader& reader, const YAML::Node& map,
+                                  const std::string& key)
+{
+  const YAML::Node node = map[key];
+  if (!node.IsDefined() || !node.IsSequence()) reader.expected(key, "a list of strings", node);
+  std::vector<std::string> values;
+  for (std::size_t i = 0; i < node.size(); ++i)
+    values.push_back(reader.text(node[i], SettingsReader::index(key, i)));
+  return values;
+}
 
-  [[noreturn]] void fail(const std::string& key, const std::string& message) const
-  {
-    throw ModelError(file_ + ": " + key + ": " + message);
-  }
-
-  /// The map at `node` must hold exactly `keys`: no unknown key, none missing.
-  void expectKeys(const YAML::Node& node, const std::string& where,
-                  const std::vector<std::string>& keys) const
-  {
-    if (!node.IsMap()) fail(where, "expected a map", node);
-    const std::set<std::string> known(keys.begin(), keys.end());
-    for (const auto& item : node)
-    {
-      const std::string key = item.first.as<std::string>();
-      if (known.count(key) == 0)
-        fail(join(where, key), "unknown key; expected one of " + list(keys));
-    }
-    for (const auto& key : keys)
-      if (!node[key]) fail(join(where, key), "missing key");
-  }
-
-  double number(const YAML::Node& map, const std::string& where, const std::string& key,
-                const std::string& unit) const
-  {
-    const YAML::Node node = map[key];
-    const std::string expected = "expected a number " + unit;
-    // A quoted scalar ("0.5") is a string, not a number, even though yaml-cpp would convert it.
-    if (!node.IsScalar() || node.Tag() == "!") fail(join(where, key), expected, node);
-    double value = 0.0;
-    try
-    {
-      value = node.as<double>();
-    }
-    catch (const YAML::Exception&)
-    {
-      fail(join(where, key), expected, node);
-    }
-    if (!std::isfinite(value)) fail(join(where, key), "expected a finite number " + unit, node);
-    return value;
-  }
-
-  int integer(const YAML::Node& map, const std::string& where, const std::string& key) const
-  {
-    const YAML::Node node = map[key];
-    if (!node.IsScalar() || node.Tag() == "!") fail(join(where, key), "expected an integer", node);
-    try
-    {
-      return node.as<int>();
-    }
-    catch (const YAML::Exception&)
-    {
-      fail(join(where, key), "expected an integer", node);
-    }
-  }
-
-  std::string text(const YAML::Node& map, const std::string& where, const std::string& key) const
-  {
-    const YAML::Node node = map[key];
-    if (!node.IsScalar()) fail(join(where, key), "expected a string", node);
-    return node.as<std::string>();
-  }
-
-  std::vector<std::string> textList(const YAML::Node& map, const std::string& where,
-                                    const std::string& key) const
-  {
-    const YAML::Node node = map[key];
-    if (!node.IsSequence()) fail(join(where, key), "expected a list of strings", node);
-    std::vector<std::string> values;
-    for (std::size_t i = 0; i < node.size(); ++i)
-    {
-      if (!node[i].IsScalar())
-        fail(join(where, key) + "[" + std::to_string(i) + "]", "expected a string", node[i]);
-      values.push_back(node[i].as<std::string>());
-    }
-    return values;
-  }
-
-private:
-  static std::string join(const std::string& where, const std::string& key)
-  {
-    return where.empty() ? key : where + "." + key;
-  }
-
-  static std::string list(const std::vector<std::string>& keys)
-  {
-    std::string out;
-    for (const auto& key : keys) out += (out.empty() ? "" : ", ") + key;
-    return out;
-  }
-
-  static std::string describe(const YAML::Node& node)
-  {
-    if (!node.IsDefined() || node.IsNull()) return "nothing";
-    if (node.IsMap()) return "a map";
-    if (node.IsSequence()) return "a list";
-    return "\"" + node.Scalar() + "\"";
-  }
-
-  std::string file_;
-};
+/// The map at `where` must hold exactly `keys`: no unknown key, none missing.
+void expectKeys(const SettingsReader& reader, const YAML::Node& node, const std::string& where,
+                const std::vector<std::string>& keys)
+{
+  reader.checkKeys(node, where, keys, keys);
+}
 
 /// What the settings file says; geometry is added from the URDF afterwards.
 RobotModel readSettings(const std::string& config_path)
 {
   const SettingsReader reader(config_path);
   const YAML::Node root = reader.load();
-  reader.expectKeys(root, "",
-                    {"drive", "wheel_joints", "limits", "laser", "odom_rate", "ground_truth_rate"});
+  expectKeys(reader, root, "",
+             {"drive", "wheel_joints", "limits", "laser", "odom_rate", "ground_truth_rate"});
   // Value checks: each names the key and the rule the value breaks.
   const auto require = [&reader](bool ok, const std::string& key, const std::string& rule,
                                  const YAML::Node& value) {
-    if (!ok) reader.fail(key, "expected " + rule, value);
+    if (!ok) reader.expected(key, rule, value);
   };
 
   RobotModel model;
-  const std::string drive = reader.text(root, "", "drive");
+  const std::string drive = reader.text(root["drive"], "drive");
   require(drive == "diff" || drive == "omni", "drive", "diff or omni", root["drive"]);
   model.drive = drive == "diff" ? DriveType::DIFF : DriveType::OMNI;
   const bool diff = model.drive == DriveType::DIFF;
 
-  model.wheel_joints = reader.textList(root, "", "wheel_joints");
+  model.wheel_joints = textList(reader, root, "wheel_joints");
   const std::size_t wheels = diff ? 2 : 4;
   if (model.wheel_joints.size() != wheels)
     reader.fail("wheel_joints", "expected " + std::to_string(wheels) + " joint names for drive " +
                                     drive + ", got " + std::to_string(model.wheel_joints.size()));
 
   const YAML::Node limits = root["limits"];
-  reader.expectKeys(limits, "limits",
-                    {"max_vel_x", "min_vel_x", "max_vel_y", "max_vel_theta", "acc_lim_x",
-                     "acc_lim_y", "acc_lim_theta"});
+  expectKeys(reader, limits, "limits",
+             {"max_vel_x", "min_vel_x", "max_vel_y", "max_vel_theta", "acc_lim_x", "acc_lim_y",
+              "acc_lim_theta"});
   Limits& lim = model.limits;
-  lim.max_vel_x = reader.number(limits, "limits", "max_vel_x", "[m/s]");
-  lim.min_vel_x = reader.number(limits, "limits", "min_vel_x", "[m/s]");
-  lim.max_vel_y = reader.number(limits, "limits", "max_vel_y", "[m/s]");
-  lim.max_vel_theta = reader.number(limits, "limits", "max_vel_theta", "[rad/s]");
-  lim.acc_lim_x = reader.number(limits, "limits", "acc_lim_x", "[m/s^2]");
-  lim.acc_lim_y = reader.number(limits, "limits", "acc_lim_y", "[m/s^2]");
-  lim.acc_lim_theta = reader.number(limits, "limits", "acc_lim_theta", "[rad/s^2]");
+  lim.max_vel_x = number(reader, limits, "limits", "max_vel_x", "[m/s]");
+  lim.min_vel_x = number(reader, limits, "limits", "min_vel_x", "[m/s]");
+  lim.max_vel_y = number(reader, limits, "limits", "max_vel_y", "[m/s]");
+  lim.max_vel_theta = number(reader, limits, "limits", "max_vel_theta", "[rad/s]");
+  lim.acc_lim_x = number(reader, limits, "limits", "acc_lim_x", "[m/s^2]");
+  lim.acc_lim_y = number(reader, limits, "limits", "acc_lim_y", "[m/s^2]");
+  lim.acc_lim_theta = number(reader, limits, "limits", "acc_lim_theta", "[rad/s^2]");
   require(lim.max_vel_x > 0.0, "limits.max_vel_x", "> 0", limits["max_vel_x"]);
   require(lim.min_vel_x <= lim.max_vel_x, "limits.min_vel_x", "<= max_vel_x", limits["min_vel_x"]);
   require(lim.max_vel_theta > 0.0, "limits.max_vel_theta", "> 0", limits["max_vel_theta"]);
@@ -228,15 +138,15 @@ RobotModel readSettings(const std::string& config_path)
           limits["acc_lim_y"]);
 
   const YAML::Node laser = root["laser"];
-  reader.expectKeys(laser, "laser",
-                    {"beams", "min_angle", "max_angle", "range_min", "range_max", "rate"});
+  expectKeys(reader, laser, "laser",
+             {"beams", "min_angle", "max_angle", "range_min", "range_max", "rate"});
   LaserSpec& spec = model.laser;
-  spec.beams = reader.integer(laser, "laser", "beams");
-  spec.min_angle = reader.number(laser, "laser", "min_angle", "[rad]");
-  spec.max_angle = reader.number(laser, "laser", "max_angle", "[rad]");
-  spec.range_min = reader.number(laser, "laser", "range_min", "[m]");
-  spec.range_max = reader.number(laser, "laser", "range_max", "[m]");
-  spec.rate = reader.number(laser, "laser", "rate", "[Hz]");
+  spec.beams = integer(reader, laser, "laser", "beams");
+  spec.min_angle = number(reader, laser, "laser", "min_angle", "[rad]");
+  spec.max_angle = number(reader, laser, "laser", "max_angle", "[rad]");
+  spec.range_min = number(reader, laser, "laser", "range_min", "[m]");
+  spec.range_max = number(reader, laser, "laser", "range_max", "[m]");
+  spec.rate = number(reader, laser, "laser", "rate", "[Hz]");
   require(spec.beams >= 1, "laser.beams", ">= 1", laser["beams"]);
   require(spec.max_angle > spec.min_angle, "laser.max_angle", "> min_angle", laser["max_angle"]);
   require(spec.max_angle - spec.min_angle <= 2.0 * kPi + kTolerance, "laser.max_angle",
@@ -245,8 +155,8 @@ RobotModel readSettings(const std::string& config_path)
   require(spec.range_max > spec.range_min, "laser.range_max", "> range_min", laser["range_max"]);
   require(spec.rate > 0.0, "laser.rate", "> 0", laser["rate"]);
 
-  model.odom_rate = reader.number(root, "", "odom_rate", "[Hz]");
-  model.ground_truth_rate = reader.number(root, "", "ground_truth_rate", "[Hz]");
+  model.odom_rate = number(reader, root, "", "odom_rate", "[Hz]");
+  model.ground_truth_rate = number(reader, root, "", "ground_truth_rate", "[Hz]");
   require(model.odom_rate > 0.0, "odom_rate", "> 0", root["odom_rate"]);
   require(model.ground_truth_rate > 0.0, "ground_truth_rate", "> 0", root["ground_truth_rate"]);
   return model;

@@ -1,14 +1,12 @@
 # Map server and localization (fake from ground truth, particle filter) of mbot_navigation.
 # Included at the end of CMakeLists.txt, after catkin_package() and include_directories().
 
-# ---- cores: likelihood field, motion and laser models, particle filter, localizer, map paths
-# -- no ROS types
+# ---- cores: likelihood field, motion and laser models, particle filter, localizer -- no ROS types
 add_library(mbot_localization
   src/likelihood_field.cpp
   src/localization_models.cpp
   src/particle_filter.cpp
-  src/localization_core.cpp
-  src/map_server.cpp)
+  src/localization_core.cpp)
 target_compile_options(mbot_localization PRIVATE -Wall -Wextra)
 
 # ---- ROS edge shared by the nodes: strict parameters, message conversions
@@ -26,14 +24,13 @@ foreach(node fake_localization pf_localization)
   add_dependencies(${node} ${catkin_EXPORTED_TARGETS})
 endforeach()
 
-# The map server reads maps with the simulator's reader (mbot_sim::loadMap in mbot_sim_core).
-find_package(mbot_sim REQUIRED)
+# The map server reads maps with mbot_common's loader (mbot_common::loadMap, in catkin_LIBRARIES),
+# the one the simulator uses too.
 find_package(roslib REQUIRED)  # ros::package::getPath, to find the workspace maps/ folder
 add_executable(map_server src/map_server_node.cpp)
 target_compile_options(map_server PRIVATE -Wall -Wextra)
-target_include_directories(map_server PRIVATE ${mbot_sim_INCLUDE_DIRS} ${roslib_INCLUDE_DIRS})
-target_link_libraries(map_server mbot_localization_ros mbot_localization ${mbot_sim_LIBRARIES}
-  ${roslib_LIBRARIES} ${catkin_LIBRARIES})
+target_include_directories(map_server PRIVATE ${roslib_INCLUDE_DIRS})
+target_link_libraries(map_server mbot_localization_ros mbot_localization ${roslib_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(map_server ${catkin_EXPORTED_TARGETS})
 
 install(TARGETS mbot_localization mbot_localization_ros
@@ -45,7 +42,6 @@ install(TARGETS fake_localization pf_localization map_server
 # ---- tests: gtest without a master, rostests with one
 if(CATKIN_ENABLE_TESTING)
   mbot_add_gtest(test_particle_filter mbot_localization)
-  mbot_add_gtest(test_map_server_paths mbot_localization)
 
   find_package(rostest REQUIRED)
   add_rostest(test/fake_localization.test)

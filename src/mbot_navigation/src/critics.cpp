@@ -13,8 +13,6 @@ constexpr double kOffMap = -4.0;
 constexpr double kThroughObstacle = -3.0;  // also: footprint over a lethal cell
 constexpr double kUnreachable = -2.0;
 constexpr double kReversal = -5.0;
-
-double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }  // [-pi, pi]
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -276,9 +274,9 @@ bool GoalAlignCritic::prepare(const CriticContext& context, std::string& error)
 double OscillationCritic::score(const Trajectory& trajectory)
 {
   const Twist2D& v = trajectory.velocity;
-  if ((forward_pos_only_ && v.x < 0.0) || (forward_neg_only_ && v.x > 0.0) ||
-      (strafe_pos_only_ && v.y < 0.0) || (strafe_neg_only_ && v.y > 0.0) ||
-      (rot_pos_only_ && v.theta < 0.0) || (rot_neg_only_ && v.theta > 0.0))
+  if ((forward_pos_only_ && v.vx < 0.0) || (forward_neg_only_ && v.vx > 0.0) ||
+      (strafe_pos_only_ && v.vy < 0.0) || (strafe_neg_only_ && v.vy > 0.0) ||
+      (rot_pos_only_ && v.wz < 0.0) || (rot_neg_only_ && v.wz > 0.0))
     return kReversal;
   return 0.0;
 }
@@ -319,12 +317,12 @@ bool OscillationCritic::setFlags(const Trajectory& chosen, double min_vel_trans)
     return set;
   };
   const Twist2D& v = chosen.velocity;
-  bool set = track(v.x, forward_pos_, forward_neg_, forward_pos_only_, forward_neg_only_);
+  bool set = track(v.vx, forward_pos_, forward_neg_, forward_pos_only_, forward_neg_only_);
   // Strafing and turning only count while the robot is not driving forward or backward.
-  if (std::fabs(v.x) <= min_vel_trans)
+  if (std::fabs(v.vx) <= min_vel_trans)
   {
-    set = track(v.y, strafe_pos_, strafe_neg_, strafe_pos_only_, strafe_neg_only_) || set;
-    set = track(v.theta, rot_pos_, rot_neg_, rot_pos_only_, rot_neg_only_) || set;
+    set = track(v.vy, strafe_pos_, strafe_neg_, strafe_pos_only_, strafe_neg_only_) || set;
+    set = track(v.wz, rot_pos_, rot_neg_, rot_pos_only_, rot_neg_only_) || set;
   }
   return set;
 }
@@ -339,7 +337,7 @@ void OscillationCritic::update(const Pose2D& robot_pose, const Trajectory& chose
   if (!restricted) return;
   const double dx = robot_pose.x - flag_pose_.x;
   const double dy = robot_pose.y - flag_pose_.y;
-  const double dth = wrapAngle(robot_pose.theta - flag_pose_.theta);
+  const double dth = mbot_common::angleDiff(robot_pose.theta, flag_pose_.theta);
   if (dx * dx + dy * dy > reset_dist_ * reset_dist_ || std::fabs(dth) > reset_angle_) reset();
 }
 
@@ -348,7 +346,7 @@ void OscillationCritic::update(const Pose2D& robot_pose, const Trajectory& chose
 
 double TwirlingCritic::score(const Trajectory& trajectory)
 {
-  return std::fabs(trajectory.velocity.theta);
+  return std::fabs(trajectory.velocity.wz);
 }
 
 }  // namespace mbot_navigation

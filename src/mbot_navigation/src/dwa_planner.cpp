@@ -10,8 +10,6 @@ namespace
 {
 constexpr double kPruneDistance = 1.0;  // [m] see prunePlan()
 
-double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }  // [-pi, pi]
-
 /// The config, after checking it (so that no member is built from a bad one).
 const DwaConfig& validated(const DwaConfig& config)
 {
@@ -63,10 +61,10 @@ bool DwaPlanner::positionReached(const Pose2D& robot_pose) const
 bool DwaPlanner::isGoalReached(const Pose2D& robot_pose, const Twist2D& robot_velocity) const
 {
   if (plan_.empty() || !positionReached(robot_pose)) return false;
-  const double yaw_error = wrapAngle(plan_.back().theta - robot_pose.theta);
-  const bool stopped = std::fabs(robot_velocity.x) <= config_.trans_stopped_vel &&
-                       std::fabs(robot_velocity.y) <= config_.trans_stopped_vel &&
-                       std::fabs(robot_velocity.theta) <= config_.theta_stopped_vel;
+  const double yaw_error = mbot_common::angleDiff(plan_.back().theta, robot_pose.theta);
+  const bool stopped = std::fabs(robot_velocity.vx) <= config_.trans_stopped_vel &&
+                       std::fabs(robot_velocity.vy) <= config_.trans_stopped_vel &&
+                       std::fabs(robot_velocity.wz) <= config_.theta_stopped_vel;
   return std::fabs(yaw_error) <= config_.yaw_goal_tolerance && stopped;
 }
 
@@ -120,7 +118,7 @@ void DwaPlanner::truncateAtGoal(Trajectory& trajectory) const
   const double tolerance = 0.5 * config_.xy_goal_tolerance;
   // Most trajectories end far from the goal: skip them without looking at every pose.
   const Pose2D& start = trajectory.poses.front();
-  const double reach = std::hypot(trajectory.velocity.x, trajectory.velocity.y) * config_.sim_time;
+  const double reach = std::hypot(trajectory.velocity.vx, trajectory.velocity.vy) * config_.sim_time;
   if (std::hypot(goal.x - start.x, goal.y - start.y) > reach + tolerance) return;
   for (size_t i = 0; i < trajectory.poses.size(); ++i)
   {
@@ -213,16 +211,16 @@ LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2
 {
   LocalPlanResult result;
   const double dt = config_.simPeriod();
-  const double yaw_error = wrapAngle(plan_.back().theta - robot_pose.theta);
+  const double yaw_error = mbot_common::angleDiff(plan_.back().theta, robot_pose.theta);
 
   // The gentlest stop the acceleration limits allow; translation always ends with it here.
   Twist2D brake;
-  brake.x = stepTowards(robot_velocity.x, 0.0, config_.acc_lim_x * dt);
-  brake.y = stepTowards(robot_velocity.y, 0.0, config_.acc_lim_y * dt);
-  brake.theta = stepTowards(robot_velocity.theta, 0.0, config_.acc_lim_theta * dt);
-  const bool stopped = std::fabs(robot_velocity.x) <= config_.trans_stopped_vel &&
-                       std::fabs(robot_velocity.y) <= config_.trans_stopped_vel &&
-                       std::fabs(robot_velocity.theta) <= config_.theta_stopped_vel;
+  brake.vx = stepTowards(robot_velocity.vx, 0.0, config_.acc_lim_x * dt);
+  brake.vy = stepTowards(robot_velocity.vy, 0.0, config_.acc_lim_y * dt);
+  brake.wz = stepTowards(robot_velocity.wz, 0.0, config_.acc_lim_theta * dt);
+  const bool stopped = std::fabs(robot_velocity.vx) <= config_.trans_stopped_vel &&
+                       std::fabs(robot_velocity.vy) <= config_.trans_stopped_vel &&
+                       std::fabs(robot_velocity.wz) <= config_.theta_stopped_vel;
 
   Twist2D command = brake;
   if (std::fabs(yaw_error) <= config_.yaw_goal_tolerance)
@@ -243,7 +241,7 @@ LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2
     double speed = std::min(config_.max_vel_theta,
                             std::sqrt(2.0 * config_.acc_lim_theta * std::fabs(yaw_error)));
     speed = std::max(speed, config_.min_vel_theta);
-    command.theta = stepTowards(robot_velocity.theta, std::copysign(speed, yaw_error),
+    command.wz = stepTowards(robot_velocity.wz, std::copysign(speed, yaw_error),
                              config_.acc_lim_theta * dt);
   }
 

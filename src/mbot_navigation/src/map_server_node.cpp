@@ -18,15 +18,16 @@
 #include <ros/ros.h>
 #include <tf2/LinearMath/Quaternion.h>
 
+#include <mbot_common/map_io.h>
+#include <mbot_common/paths.h>
+
 #include "mbot_navigation/localization_ros.h"
-#include "mbot_navigation/map_server.h"
-#include "mbot_sim/map_io.h"
 
 namespace mbot_navigation
 {
 namespace map_server
 {
-nav_msgs::OccupancyGrid toOccupancyGrid(const mbot_sim::OccupancyMap& map, const std::string& frame_id)
+nav_msgs::OccupancyGrid toOccupancyGrid(const mbot_common::OccupancyMap& map, const std::string& frame_id)
 {
   nav_msgs::OccupancyGrid grid;
   grid.header.frame_id = frame_id;
@@ -60,10 +61,11 @@ public:
     if (name.empty())
       throw std::runtime_error("no map given: rosrun mbot_navigation map_server MAP.yaml, or the "
                                "parameter ~map (a path, or a name in the workspace maps/ folder)");
-    const std::string path =
-        resolveMapPath(name, findMapsDirectory(ros::package::getPath("mbot_navigation")));
+    // a bare name: maps/NAME.yaml next to this package's workspace, then mbot_common's workspace
+    const std::string path = mbot_common::resolveMapPath(
+        name, mbot_common::findMapsDirectory(ros::package::getPath("mbot_navigation")));
 
-    grid_ = toOccupancyGrid(mbot_sim::loadMap(path), frame_id);  // throws MapError naming the file
+    grid_ = toOccupancyGrid(mbot_common::loadMap(path), frame_id);  // throws MapError naming the file
     map_pub_ = nh.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
     metadata_pub_ = nh.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
     service_ = nh.advertiseService("static_map", &MapServerNode::onGetMap, this);

@@ -557,9 +557,9 @@ void NavNode::cycle(const ros::TimerEvent&)
               navigator_->lastError().empty() ? "" : "; last error: ", navigator_->lastError().c_str());
 
   geometry_msgs::Twist cmd;
-  cmd.linear.x = result.cmd.x;
-  cmd.linear.y = result.cmd.y;
-  cmd.angular.z = result.cmd.theta;
+  cmd.linear.x = result.cmd.vx;
+  cmd.linear.y = result.cmd.vy;
+  cmd.angular.z = result.cmd.wz;
   cmd_vel_pub_.publish(cmd);
   if (result.plan_updated) publishPath(global_plan_pub_, navigator_->globalPlan(), now);
   publishPath(local_plan_pub_, navigator_->localPlan().poses, now);
@@ -602,9 +602,9 @@ void NavNode::publishPath(const ros::Publisher& pub, const std::vector<Pose2D>& 
 
 void NavNode::onOdom(const nav_msgs::Odometry::ConstPtr& odom)
 {
-  velocity_.x = odom->twist.twist.linear.x;
-  velocity_.y = odom->twist.twist.linear.y;
-  velocity_.theta = odom->twist.twist.angular.z;
+  velocity_.vx = odom->twist.twist.linear.x;
+  velocity_.vy = odom->twist.twist.linear.y;
+  velocity_.wz = odom->twist.twist.angular.z;
 }
 
 // =============================================================================================

@@ -9,11 +9,6 @@ namespace mbot_navigation
 namespace
 {
 constexpr double kTwoPi = 6.283185307179586;
-
-double wrap(double a)
-{
-  return std::atan2(std::sin(a), std::cos(a));
-}
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -33,14 +28,14 @@ void RotateRecovery::start(const RecoveryInput& input)
   start_time_ = input.now;
   last_yaw_ = input.pose.theta;
   turned_ = 0.0;
-  last_cmd_ = input.velocity.theta;
+  last_cmd_ = input.velocity.wz;
 }
 
 RecoveryStatus RotateRecovery::step(const RecoveryInput& input, Twist2D& cmd)
 {
   cmd = Twist2D{};
   // Count the turn from the measured yaw (what the robot really did, not what we asked).
-  turned_ += wrap(input.pose.theta - last_yaw_);
+  turned_ += mbot_common::angleDiff(input.pose.theta, last_yaw_);
   last_yaw_ = input.pose.theta;
   const double remaining = kTwoPi - config_.tolerance - turned_;
   if (remaining <= 0.0) return RecoveryStatus::DONE;
@@ -57,7 +52,7 @@ RecoveryStatus RotateRecovery::step(const RecoveryInput& input, Twist2D& cmd)
   w = std::min(w, std::max(last_cmd_, 0.0) + config_.acc_lim_theta * config_.control_period);
   w = std::max(w, config_.min_vel_theta);
   last_cmd_ = w;
-  cmd.theta = w;
+  cmd.wz = w;
   return RecoveryStatus::RUNNING;
 }
 
@@ -134,7 +129,7 @@ RecoveryStatus BackUpRecovery::step(const RecoveryInput& input, Twist2D& cmd)
     message_ = buf;
     return RecoveryStatus::FAILED;
   }
-  cmd.x = -config_.speed;
+  cmd.vx = -config_.speed;
   return RecoveryStatus::RUNNING;
 }
 

@@ -20,9 +20,9 @@ Pose2D integratePose(const Pose2D& pose, const Twist2D& velocity, double dt)
   const double c = std::cos(pose.theta);
   const double s = std::sin(pose.theta);
   Pose2D next;
-  next.x = pose.x + (velocity.x * c - velocity.y * s) * dt;
-  next.y = pose.y + (velocity.x * s + velocity.y * c) * dt;
-  next.theta = pose.theta + velocity.theta * dt;
+  next.x = pose.x + (velocity.vx * c - velocity.vy * s) * dt;
+  next.y = pose.y + (velocity.vx * s + velocity.vy * c) * dt;
+  next.theta = pose.theta + velocity.wz * dt;
   return next;
 }
 
@@ -56,17 +56,17 @@ void TrajectoryGenerator::initialise(const Twist2D& velocity)
 {
   const double dt = config_.simPeriod();
   // The dynamic window: what one control period of acceleration can reach, within the limits.
-  const double max_vx = std::min(config_.max_vel_x, velocity.x + config_.acc_lim_x * dt);
-  const double min_vx = std::max(config_.min_vel_x, velocity.x - config_.acc_lim_x * dt);
+  const double max_vx = std::min(config_.max_vel_x, velocity.vx + config_.acc_lim_x * dt);
+  const double min_vx = std::max(config_.min_vel_x, velocity.vx - config_.acc_lim_x * dt);
   double max_vy = config_.max_vel_y;
   double min_vy = config_.min_vel_y;
   if (max_vy > min_vy)  // an omni robot; a diff-drive robot keeps its single v_y sample
   {
-    max_vy = std::min(max_vy, velocity.y + config_.acc_lim_y * dt);
-    min_vy = std::max(min_vy, velocity.y - config_.acc_lim_y * dt);
+    max_vy = std::min(max_vy, velocity.vy + config_.acc_lim_y * dt);
+    min_vy = std::max(min_vy, velocity.vy - config_.acc_lim_y * dt);
   }
-  const double max_vth = std::min(config_.max_vel_theta, velocity.theta + config_.acc_lim_theta * dt);
-  const double min_vth = std::max(-config_.max_vel_theta, velocity.theta - config_.acc_lim_theta * dt);
+  const double max_vth = std::min(config_.max_vel_theta, velocity.wz + config_.acc_lim_theta * dt);
+  const double min_vth = std::max(-config_.max_vel_theta, velocity.wz - config_.acc_lim_theta * dt);
 
   // A robot that is faster than its limits (pushed, or limits just lowered) gets an empty
   // range on that axis; sampleRange then gives the one reachable value closest to the limits.
@@ -95,9 +95,9 @@ void TrajectoryGenerator::initialise(const Twist2D& velocity)
 
 bool TrajectoryGenerator::isAdmissible(const Twist2D& sample) const
 {
-  const double vmag = std::hypot(sample.x, sample.y);
+  const double vmag = std::hypot(sample.vx, sample.vy);
   // Too slow both ways: such a sample would hardly move the robot (a real base stalls).
-  if (vmag + kEps < min_vel_trans_ && std::fabs(sample.theta) + kEps < min_vel_theta_) return false;
+  if (vmag + kEps < min_vel_trans_ && std::fabs(sample.wz) + kEps < min_vel_theta_) return false;
   return vmag - kEps <= config_.max_vel_trans;
 }
 
@@ -111,8 +111,8 @@ bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
 
   // Enough steps that no step moves more than sim_granularity or turns more than
   // angular_sim_granularity, so that no obstacle cell is stepped over.
-  const double distance = std::hypot(sample.x, sample.y) * config_.sim_time;
-  const double angle = std::fabs(sample.theta) * config_.sim_time;
+  const double distance = std::hypot(sample.vx, sample.vy) * config_.sim_time;
+  const double angle = std::fabs(sample.wz) * config_.sim_time;
   const int steps = std::max(
       1, static_cast<int>(std::ceil(std::max(distance / config_.sim_granularity,
                                              angle / config_.angular_sim_granularity))));
@@ -121,7 +121,7 @@ bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
 
   // Euler steps, as integratePose() but without a sine and cosine per step: the heading turns
   // by the same angle every step, so its unit vector (c, s) is rotated by that angle instead.
-  const double dth = sample.theta * dt;
+  const double dth = sample.wz * dt;
   const double cd = std::cos(dth);
   const double sd = std::sin(dth);
   double c = std::cos(pose.theta);
@@ -131,8 +131,8 @@ bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
   trajectory.poses.push_back(p);
   for (int i = 0; i < steps; ++i)
   {
-    p.x += (sample.x * c - sample.y * s) * dt;
-    p.y += (sample.x * s + sample.y * c) * dt;
+    p.x += (sample.vx * c - sample.vy * s) * dt;
+    p.y += (sample.vx * s + sample.vy * c) * dt;
     p.theta += dth;
     const double c_next = c * cd - s * sd;
     s = s * cd + c * sd;
@@ -150,7 +150,7 @@ void TrajectoryGenerator::generateBraking(const Pose2D& pose, const Twist2D& com
   trajectory.poses.clear();
 
   // Small time steps so that a step stays below sim_granularity even at full speed.
-  const double top_speed = std::max(config_.max_vel_trans, std::hypot(command.x, command.y));
+  const double top_speed = std::max(config_.max_vel_trans, std::hypot(command.vx, command.vy));
   const double dt = std::min(config_.simPeriod(), config_.sim_granularity / top_speed);
   trajectory.time_delta = dt;
 
@@ -163,10 +163,10 @@ void TrajectoryGenerator::generateBraking(const Pose2D& pose, const Twist2D& com
   {
     if (t >= config_.simPeriod())  // after the first period: brake
     {
-      v.x = stepTowards(v.x, 0.0, config_.acc_lim_x * dt);
-      v.y = stepTowards(v.y, 0.0, config_.acc_lim_y * dt);
-      v.theta = stepTowards(v.theta, 0.0, config_.acc_lim_theta * dt);
-      if (v.x == 0.0 && v.y == 0.0 && v.theta == 0.0) break;
+      v.vx = stepTowards(v.vx, 0.0, config_.acc_lim_x * dt);
+      v.vy = stepTowards(v.vy, 0.0, config_.acc_lim_y * dt);
+      v.wz = stepTowards(v.wz, 0.0, config_.acc_lim_theta * dt);
+      if (v.vx == 0.0 && v.vy == 0.0 && v.wz == 0.0) break;
     }
     p = integratePose(p, v, dt);
     trajectory.poses.push_back(p);

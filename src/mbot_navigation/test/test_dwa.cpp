@@ -100,8 +100,6 @@ int maxCostUnderFootprint(const Costmap2D& map, double x, double y)
   return worst;
 }
 
-double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
-
 /// The robot's rolling local costmap: 4 x 4 m at the world map's resolution, centred on the
 /// robot (origin snapped to the world grid), costs copied from the world map, as the nav node's
 /// local costmap would hold them. Cells beyond the world map are NO_INFORMATION.
@@ -167,9 +165,9 @@ void expectWithinAccelerationLimits(const ClosedLoopRun& run, const DwaConfig& c
   {
     if (!run.results[i].ok) break;  // a failure commands zero at once (recoveries take over)
     const Twist2D& cmd = run.commands[i];
-    EXPECT_LE(std::fabs(cmd.x - previous.x), c.acc_lim_x * dt + 1e-9) << "cycle " << i;
-    EXPECT_LE(std::fabs(cmd.y - previous.y), c.acc_lim_y * dt + 1e-9) << "cycle " << i;
-    EXPECT_LE(std::fabs(cmd.theta - previous.theta), c.acc_lim_theta * dt + 1e-9) << "cycle " << i;
+    EXPECT_LE(std::fabs(cmd.vx - previous.vx), c.acc_lim_x * dt + 1e-9) << "cycle " << i;
+    EXPECT_LE(std::fabs(cmd.vy - previous.vy), c.acc_lim_y * dt + 1e-9) << "cycle " << i;
+    EXPECT_LE(std::fabs(cmd.wz - previous.wz), c.acc_lim_theta * dt + 1e-9) << "cycle " << i;
     previous = cmd;
   }
 }
@@ -185,11 +183,11 @@ TEST(TrajectoryGenerator, SamplesTheDynamicWindow)
   double min_x = 1e9, max_x = -1e9, min_w = 1e9, max_w = -1e9;
   for (const Twist2D& s : generator.samples())
   {
-    min_x = std::min(min_x, s.x);
-    max_x = std::max(max_x, s.x);
-    min_w = std::min(min_w, s.theta);
-    max_w = std::max(max_w, s.theta);
-    EXPECT_EQ(s.y, 0.0);
+    min_x = std::min(min_x, s.vx);
+    max_x = std::max(max_x, s.vx);
+    min_w = std::min(min_w, s.wz);
+    max_w = std::max(max_w, s.wz);
+    EXPECT_EQ(s.vy, 0.0);
   }
   EXPECT_NEAR(min_x, 0.3 - dv, 1e-12);
   EXPECT_NEAR(max_x, 0.3 + dv, 1e-12);
@@ -200,7 +198,7 @@ TEST(TrajectoryGenerator, SamplesTheDynamicWindow)
 
   // Near max_vel_x the window is clipped.
   generator.initialise(Twist2D{0.5, 0.0, 0.0});
-  for (const Twist2D& s : generator.samples()) EXPECT_LE(s.x, c.max_vel_x);
+  for (const Twist2D& s : generator.samples()) EXPECT_LE(s.vx, c.max_vel_x);
 
   // A trajectory lasts sim_time, with steps of at most sim_granularity.
   Trajectory t;
@@ -236,8 +234,8 @@ TEST(DwaPlanner, FailsWithoutAPlan)
   const LocalPlanResult r = planner.computeVelocityCommands(Pose2D{2.0, 2.0, 0.0}, Twist2D{}, map, cmd);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.error.find("no global plan"), std::string::npos) << r.error;
-  EXPECT_EQ(cmd.x, 0.0);
-  EXPECT_EQ(cmd.theta, 0.0);
+  EXPECT_EQ(cmd.vx, 0.0);
+  EXPECT_EQ(cmd.wz, 0.0);
 }
 
 TEST(DwaPlanner, FollowsAStraightPlanAtFullSpeed)
@@ -253,10 +251,10 @@ TEST(DwaPlanner, FollowsAStraightPlanAtFullSpeed)
   // From rest, max_vel_x is reachable after 0.55 / 0.125 = 5 cycles; from 1 s on it cruises.
   for (size_t i = 20; i < run.commands.size(); ++i)
   {
-    EXPECT_GE(run.commands[i].x, 0.95 * c.max_vel_x) << "cycle " << i;
-    EXPECT_LE(run.commands[i].x, c.max_vel_x + 1e-12) << "cycle " << i;
-    EXPECT_LT(std::fabs(run.commands[i].theta), 0.05) << "cycle " << i;
-    EXPECT_EQ(run.commands[i].y, 0.0);
+    EXPECT_GE(run.commands[i].vx, 0.95 * c.max_vel_x) << "cycle " << i;
+    EXPECT_LE(run.commands[i].vx, c.max_vel_x + 1e-12) << "cycle " << i;
+    EXPECT_LT(std::fabs(run.commands[i].wz), 0.05) << "cycle " << i;
+    EXPECT_EQ(run.commands[i].vy, 0.0);
   }
   for (const Pose2D& p : run.poses) EXPECT_LT(std::fabs(p.y - 2.0), 0.02);
   EXPECT_GT(run.final_pose.x, 0.5 + 0.8 * c.max_vel_x * 3.0);
@@ -316,9 +314,9 @@ TEST(DwaPlanner, ReportsFailureWhenWalledIn)
     // Most samples drive into the box; the slow turns in place that stay clear cannot reach the
     // goal (the distance map does not get out of the box either).
     EXPECT_NE(r.error.find("obstacle: "), std::string::npos) << r.error;
-    EXPECT_EQ(cmd.x, 0.0);
-    EXPECT_EQ(cmd.y, 0.0);
-    EXPECT_EQ(cmd.theta, 0.0);
+    EXPECT_EQ(cmd.vx, 0.0);
+    EXPECT_EQ(cmd.vy, 0.0);
+    EXPECT_EQ(cmd.wz, 0.0);
   }
 }
 
@@ -335,9 +333,9 @@ TEST(DwaPlanner, StopsAtTheGoalWithinTolerances)
                            << run.final_pose.y << ", " << run.final_pose.theta << ")";
   for (const LocalPlanResult& r : run.results) ASSERT_TRUE(r.ok) << r.error;
   EXPECT_LE(std::hypot(run.final_pose.x - 3.0, run.final_pose.y - 2.5), c.xy_goal_tolerance);
-  EXPECT_LE(std::fabs(wrap(run.final_pose.theta - goal_yaw)), c.yaw_goal_tolerance);
-  EXPECT_LE(std::fabs(run.final_velocity.x), c.trans_stopped_vel);
-  EXPECT_LE(std::fabs(run.final_velocity.theta), c.theta_stopped_vel);
+  EXPECT_LE(std::fabs(mbot_common::angleDiff(run.final_pose.theta, goal_yaw)), c.yaw_goal_tolerance);
+  EXPECT_LE(std::fabs(run.final_velocity.vx), c.trans_stopped_vel);
+  EXPECT_LE(std::fabs(run.final_velocity.wz), c.theta_stopped_vel);
   // It turned in place to the goal yaw (the plan arrives heading ~31 deg, the goal is 90 deg).
   const bool rotated = std::any_of(run.results.begin(), run.results.end(), [](const LocalPlanResult& r) {
     return r.state == LocalPlannerState::ROTATING;
@@ -348,8 +346,8 @@ TEST(DwaPlanner, StopsAtTheGoalWithinTolerances)
   // Once there, it stays there: the commands brake to exactly zero within a few cycles.
   ClosedLoopRun after = simulate(planner, map, run.final_pose, 20, false);
   for (size_t i = 0; i < after.results.size(); ++i) ASSERT_TRUE(after.results[i].ok);
-  EXPECT_EQ(after.commands.back().x, 0.0);
-  EXPECT_EQ(after.commands.back().theta, 0.0);
+  EXPECT_EQ(after.commands.back().vx, 0.0);
+  EXPECT_EQ(after.commands.back().wz, 0.0);
   EXPECT_LT(std::hypot(after.final_pose.x - run.final_pose.x, after.final_pose.y - run.final_pose.y), 0.01);
   EXPECT_TRUE(planner.isGoalReached(after.final_pose, after.final_velocity));
 }
@@ -371,10 +369,10 @@ TEST(DwaPlanner, RespectsAccelerationLimitsOnACurvyPlan)
     expectWithinAccelerationLimits(run, c);
     for (const Twist2D& cmd : run.commands)
     {
-      EXPECT_LE(cmd.x, c.max_vel_x + 1e-12);
-      EXPECT_GE(cmd.x, c.min_vel_x - 1e-12);
-      EXPECT_LE(std::fabs(cmd.theta), c.max_vel_theta + 1e-12);
-      EXPECT_LE(std::hypot(cmd.x, cmd.y), c.max_vel_trans + 1e-4);
+      EXPECT_LE(cmd.vx, c.max_vel_x + 1e-12);
+      EXPECT_GE(cmd.vx, c.min_vel_x - 1e-12);
+      EXPECT_LE(std::fabs(cmd.wz), c.max_vel_theta + 1e-12);
+      EXPECT_LE(std::hypot(cmd.vx, cmd.vy), c.max_vel_trans + 1e-4);
     }
   }
 }
@@ -395,8 +393,8 @@ TEST(DwaPlanner, StartsFromRestWithLowAccelerationLimits)
   planner.setPlan(straightPlan(0.5, 2.0, 5.5, 2.0, 0.0));
   const ClosedLoopRun run = simulate(planner, world, Pose2D{0.5, 2.0, 0.0}, 40);  // 2 s
   for (const LocalPlanResult& r : run.results) ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_NEAR(run.commands.front().x, c.acc_lim_x * c.simPeriod(), 1e-12);  // full acceleration
-  EXPECT_GE(run.commands.back().x, 0.95 * c.max_vel_x);  // 0.5 s to full speed, then cruising
+  EXPECT_NEAR(run.commands.front().vx, c.acc_lim_x * c.simPeriod(), 1e-12);  // full acceleration
+  EXPECT_GE(run.commands.back().vx, 0.95 * c.max_vel_x);  // 0.5 s to full speed, then cruising
   expectWithinAccelerationLimits(run, c);
 }
 
@@ -412,7 +410,7 @@ TEST(DwaPlanner, OmniRobotSidestepsBackOntoThePlan)
   };
   const auto max_yaw = [](const ClosedLoopRun& run) {
     double m = 0.0;
-    for (const Pose2D& p : run.poses) m = std::max(m, std::fabs(wrap(p.theta)));
+    for (const Pose2D& p : run.poses) m = std::max(m, std::fabs(mbot_common::normalizeAngle(p.theta)));
     return m;
   };
 
@@ -420,7 +418,7 @@ TEST(DwaPlanner, OmniRobotSidestepsBackOntoThePlan)
   const ClosedLoopRun strafe = run_with(omni);
   for (const LocalPlanResult& r : strafe.results) ASSERT_TRUE(r.ok) << r.error;
   double strafed = 0.0;  // lateral distance covered with v_y [m], towards the plan is negative
-  for (const Twist2D& cmd : strafe.commands) strafed += cmd.y * omni.simPeriod();
+  for (const Twist2D& cmd : strafe.commands) strafed += cmd.vy * omni.simPeriod();
   EXPECT_LT(strafed, -0.15);             // most of the 0.25 m, sideways
   EXPECT_LT(max_yaw(strafe), 0.1);       // without turning much
   expectWithinAccelerationLimits(strafe, omni);
@@ -428,7 +426,7 @@ TEST(DwaPlanner, OmniRobotSidestepsBackOntoThePlan)
   const DwaConfig diff = mbotOmniConfig(false);
   const ClosedLoopRun steer = run_with(diff);
   for (const LocalPlanResult& r : steer.results) ASSERT_TRUE(r.ok) << r.error;
-  for (const Twist2D& cmd : steer.commands) EXPECT_EQ(cmd.y, 0.0);
+  for (const Twist2D& cmd : steer.commands) EXPECT_EQ(cmd.vy, 0.0);
   // After 2 s the omni robot is much closer to the plan, and turned less on the way.
   const double omni_error = std::fabs(strafe.final_pose.y - 2.0);
   const double diff_error = std::fabs(steer.final_pose.y - 2.0);

@@ -16,7 +16,7 @@ import unittest
 import rospy
 import rostest
 import rospkg
-import yaml
+from mbot_common.maps import load_map
 from nav_msgs.msg import MapMetaData, OccupancyGrid
 from nav_msgs.srv import GetMap
 from roslib.packages import find_node
@@ -31,18 +31,6 @@ FIXTURE = [0, -1, 0, 100,
 FIXTURE_NEGATED = [100, -1, 100, 0,
                    100, 100, 0, 100,
                    0, 100, 100, -1]
-
-
-def pgm_size(path):
-    """Width and height from a PGM header (comments allowed)."""
-    with open(path, "rb") as f:
-        tokens = []
-        while len(tokens) < 3:
-            line = f.readline()
-            if not line:
-                break
-            tokens += line.split(b"#")[0].split()
-    return int(tokens[1]), int(tokens[2])
 
 
 class MapServerTest(unittest.TestCase):
@@ -84,11 +72,9 @@ class MapServerTest(unittest.TestCase):
         # the workspace's maps/ folder is next to src/, which holds this package
         package = os.path.realpath(rospkg.RosPack().get_path(PKG))
         maps = os.path.join(os.path.dirname(os.path.dirname(package)), "maps")
-        with open(os.path.join(maps, "empty.yaml")) as f:
-            spec = yaml.safe_load(f)
-        width, height = pgm_size(os.path.join(maps, spec["image"]))
+        expected = load_map(os.path.join(maps, "empty.yaml"))
         grid = rospy.wait_for_message("/bare/map", OccupancyGrid, timeout=TIMEOUT)
-        self.check_info(grid.info, width, height, spec["resolution"], spec["origin"])
+        self.check_info(grid.info, expected.width, expected.height, expected.resolution, expected.origin)
 
     def run_map_server(self, *args):
         binary = find_node(PKG, "map_server")

@@ -250,16 +250,16 @@ TEST(RotateRecovery, TurnsOnceWithinLimits)
     Twist2D cmd;
     status = rotate.step(in, cmd);
     if (status != RecoveryStatus::RUNNING) break;
-    EXPECT_EQ(cmd.x, 0.0);
-    max_w = std::max(max_w, cmd.theta);
+    EXPECT_EQ(cmd.vx, 0.0);
+    max_w = std::max(max_w, cmd.wz);
     if (first_w < 0.0)
-      first_w = cmd.theta;
+      first_w = cmd.wz;
     else
-      max_dw = std::max(max_dw, cmd.theta - last_w);
-    last_w = cmd.theta;
+      max_dw = std::max(max_dw, cmd.wz - last_w);
+    last_w = cmd.wz;
     in.now += 0.05;
-    in.pose.theta = std::atan2(std::sin(in.pose.theta + cmd.theta * 0.05), std::cos(in.pose.theta + cmd.theta * 0.05));
-    turned += cmd.theta * 0.05;
+    in.pose.theta = mbot_common::normalizeAngle(in.pose.theta + cmd.wz * 0.05);
+    turned += cmd.wz * 0.05;
   }
   EXPECT_EQ(status, RecoveryStatus::DONE);
   EXPECT_NEAR(turned, 2.0 * kPi - config.tolerance, 0.06);
@@ -311,7 +311,7 @@ TEST(BackUpRecovery, BacksUpAsFarAsTheWayIsFree)
   int steps = 0;
   while ((status = back_up.step(in, cmd)) == RecoveryStatus::RUNNING && steps++ < 200)
   {
-    EXPECT_DOUBLE_EQ(cmd.x, -0.1);
+    EXPECT_DOUBLE_EQ(cmd.vx, -0.1);
     in.pose = integratePose(in.pose, cmd, 0.05);
     in.now += 0.05;
   }
@@ -324,7 +324,7 @@ TEST(BackUpRecovery, BacksUpAsFarAsTheWayIsFree)
   blocked.start(at_wall);
   EXPECT_EQ(blocked.step(at_wall, cmd), RecoveryStatus::FAILED);
   EXPECT_TRUE(contains(blocked.message(), "no room to back up")) << blocked.message();
-  EXPECT_EQ(cmd.x, 0.0);
+  EXPECT_EQ(cmd.vx, 0.0);
 }
 
 // =============================================================================================
@@ -348,7 +348,7 @@ TEST(Navigator, ReachesAGoalThroughADoor)
   ASSERT_EQ(outcome, NavOutcome::SUCCEEDED) << sim.last.text << " at t = " << sim.t;
   EXPECT_EQ(nav.state(), NavState::IDLE);
   EXPECT_LT(std::hypot(sim.pose.x - goal.x, sim.pose.y - goal.y), 0.1 + 1e-6);
-  EXPECT_LT(std::fabs(std::remainder(sim.pose.theta - goal.theta, 2 * kPi)), 0.1 + 1e-6);
+  EXPECT_LT(std::fabs(mbot_common::angleDiff(sim.pose.theta, goal.theta)), 0.1 + 1e-6);
   // Through the door: (-2.5, -2) -> (0, 0) -> (2.5, 2) is 6.40 m; allow 15 % for the curves.
   EXPECT_GT(sim.travelled, 6.3);
   EXPECT_LT(sim.travelled, 6.40 * 1.15);
@@ -452,12 +452,12 @@ TEST(Navigator, CancelStopsAndANewGoalReplaces)
   Sim sim{nav, *global, *local, Pose2D{-2.5, -2.0, 0.0}};
   sim.run(3.0);
   EXPECT_EQ(nav.state(), NavState::CONTROLLING);
-  EXPECT_GT(std::hypot(sim.last.cmd.x, sim.last.cmd.theta), 0.05);
+  EXPECT_GT(std::hypot(sim.last.cmd.vx, sim.last.cmd.wz), 0.05);
   nav.cancel();
   const NavCycleResult idle = nav.cycle(sim.t, sim.pose, sim.velocity, global->costmap(), local->costmap());
   EXPECT_EQ(idle.outcome, NavOutcome::NONE);
-  EXPECT_EQ(idle.cmd.x, 0.0);
-  EXPECT_EQ(idle.cmd.theta, 0.0);
+  EXPECT_EQ(idle.cmd.vx, 0.0);
+  EXPECT_EQ(idle.cmd.wz, 0.0);
 
   // A new goal in the same room.
   nav.setGoal(Pose2D{-3.0, 2.0, 0.0}, sim.t);

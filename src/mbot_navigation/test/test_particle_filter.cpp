@@ -111,7 +111,7 @@ TEST(LocalizationMath, ComposeAndInvertAreConsistent)
 {
   const Pose2D a = pose(1.0, -2.0, 2.5), b = pose(0.3, 0.4, -3.0);
   const Pose2D ab = compose(a, b);
-  const Pose2D back = compose(invert(a), ab);  // a^-1 * a * b = b
+  const Pose2D back = compose(inverse(a), ab);  // a^-1 * a * b = b
   EXPECT_NEAR(back.x, b.x, 1e-12);
   EXPECT_NEAR(back.y, b.y, 1e-12);
   EXPECT_NEAR(angleDiff(back.theta, b.theta), 0.0, 1e-12);
@@ -196,7 +196,7 @@ TEST(OdomMotionModel, ZeroNoiseMovesParticlesExactly)
       const std::vector<Particle> before = particles;
       model.apply(move.first, move.second, particles, rng);
       // the odometry motion, seen from the old odometry pose, applied in each particle's frame
-      const Pose2D relative = compose(invert(move.first), move.second);
+      const Pose2D relative = compose(inverse(move.first), move.second);
       for (size_t i = 0; i < particles.size(); ++i)
       {
         const Pose2D expected = compose(before[i].pose, relative);

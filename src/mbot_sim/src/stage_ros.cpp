@@ -4,6 +4,7 @@
  */
 #include "mbot_sim/stage_ros.h"
 
+#include <mbot_common/paths.h>
 #include <mbot_msgs/Contact.h>
 #include <ros/callback_queue.h>
 #include <ros/package.h>
@@ -11,8 +12,7 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
-#include <sys/stat.h>
-
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -20,17 +20,14 @@ namespace mbot_sim
 {
 namespace
 {
-bool fileExists(const std::string& path)
-{
-  struct stat info;
-  return stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
-}
-
 geometry_msgs::Quaternion yawToQuaternion(double yaw)
 {
+  const std::array<double, 4> xyzw = mbot_common::quaternionFromYaw(yaw);
   geometry_msgs::Quaternion q;
-  q.z = std::sin(yaw / 2.0);
-  q.w = std::cos(yaw / 2.0);
+  q.x = xyzw[0];
+  q.y = xyzw[1];
+  q.z = xyzw[2];
+  q.w = xyzw[3];
   return q;
 }
 
@@ -41,7 +38,7 @@ void fillOdometry(nav_msgs::Odometry& msg, double stamp, const Pose2D& pose, con
   msg.pose.pose.position.x = pose.x;
   msg.pose.pose.position.y = pose.y;
   msg.pose.pose.position.z = 0.0;
-  msg.pose.pose.orientation = yawToQuaternion(pose.yaw);
+  msg.pose.pose.orientation = yawToQuaternion(pose.theta);
   msg.twist.twist.linear.x = twist.vx;
   msg.twist.twist.linear.y = twist.vy;
   msg.twist.twist.angular.z = twist.wz;
@@ -92,33 +89,21 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   return p;
 }
 
-std::string resolveWorldPath(const std::string& world, const std::string& maps_dir)
-{
-  const bool is_path = world.find('/') != std::string::npos ||
-                       (world.size() > 5 && world.compare(world.size() - 5, 5, ".yaml") == 0);
-  if (is_path) return world;  // the world reader reports a missing file with its name
-
-  std::vector<std::string> candidates;
-  if (!maps_dir.empty()) candidates.push_back(maps_dir + "/" + world + ".world.yaml");
-  const std::string pkg = ros::package::getPath("mbot_sim");
-  if (!pkg.empty())
-  {
-    candidates.push_back(pkg + "/../../maps/" + world + ".world.yaml");  // source space: <ws>/src/mbot_sim
-    candidates.push_back(pkg + "/maps/" + world + ".world.yaml");        // an install that ships maps
-  }
-  for (const auto& c : candidates)
-    if (fileExists(c)) return c;
-  std::string searched;
-  for (const auto& c : candidates) searched += (searched.empty() ? "" : ", ") + c;
-  throw StartupError("world \"" + world + "\": no world file of that name (searched " + searched + ")");
-}
-
 // =============================================================================================
 // construction
 
 StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(nh), params_(params)
 {
-  const std::string path = resolveWorldPath(params.world, params.maps_dir);
+  std::string path;
+  try
+  {
+    // a name: maps_dir, then the workspace's maps/ (mbot_common::resolveWorldPath)
+    path = mbot_common::resolveWorldPath(params.world, params.maps_dir);
+  }
+  catch (const mbot_common::ConfigError& e)
+  {
+    throw StartupError(e.what());
+  }
   description_dir_ = ros::package::getPath("mbot_description");
   if (description_dir_.empty()) throw StartupError("cannot find the package mbot_description (for the robot models)");
 
@@ -257,7 +242,7 @@ void StageRos::publishMarkers()
     m.pose.position.x = o.pose.x;
     m.pose.position.y = o.pose.y;
     m.pose.position.z = 0.25;
-    m.pose.orientation = yawToQuaternion(o.pose.yaw);
+    m.pose.orientation = yawToQuaternion(o.pose.theta);
     m.scale.x = box ? o.shape.length : 2.0 * o.shape.radius;
     m.scale.y = box ? o.shape.width : 2.0 * o.shape.radius;
     m.scale.z = 0.5;

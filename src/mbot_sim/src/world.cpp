@@ -33,12 +33,12 @@
 
 namespace mbot_sim
 {
+using mbot_common::normalizeAngle;
 using mbot_description::DriveType;
 using mbot_description::RobotModel;
 
 namespace
 {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Every body is an upright 1 m tall prism centred 0.5 m above the ground, so contact normals
 // between bodies are horizontal.
@@ -93,8 +93,6 @@ using BodyPtr = std::unique_ptr<dxBody, BodyDeleter>;
 using JointGroupPtr = std::unique_ptr<dxJointGroup, JointGroupDeleter>;
 
 double clamp(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
-
-double normalizeAngle(double a) { return std::remainder(a, 2.0 * kPi); }
 
 /// Move `v` towards `target` by at most `max_change`.
 double approach(double v, double target, double max_change)
@@ -249,9 +247,9 @@ void setGeomPose(dGeomID geom, double x, double y, double yaw)
 /// The outline's centre and heading in the map frame for a body at `pose`.
 Pose2D outlinePose(const Outline& o, const Pose2D& pose)
 {
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   return Pose2D{pose.x + c * o.offset_x - s * o.offset_y, pose.y + s * o.offset_x + c * o.offset_y,
-                pose.yaw + o.offset_yaw};
+                pose.theta + o.offset_yaw};
 }
 
 /// A delayed sample (latency fault): handed to the listener at `release` [s sim time].
@@ -526,7 +524,7 @@ struct World::Impl
   {
     GeomPtr geom = makeGeom(outline, settings.contact_margin, robot);
     const Pose2D p = outlinePose(outline, pose);
-    setGeomPose(geom.get(), p.x, p.y, p.yaw);
+    setGeomPose(geom.get(), p.x, p.y, p.theta);
     OverlapQuery q;
     q.query = geom.get();
     q.exclude = exclude;
@@ -542,7 +540,7 @@ struct World::Impl
   int addRobot(const std::string& name, const RobotModel& model, const Pose2D& pose)
   {
     claimName(name, "robot");
-    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw))
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
       throw SimError("robot " + name + ": the pose is not finite");
     if (!insideMap(pose.x, pose.y))
       throw SimError("robot " + name + " at " + formatPoint(pose.x, pose.y) + " is outside the map");
@@ -628,11 +626,11 @@ struct World::Impl
   void placeBody(Robot& r, const Pose2D& pose)
   {
     dBodySetPosition(r.body.get(), pose.x, pose.y, kBodyZ);
-    dQuaternion q = {std::cos(pose.yaw / 2.0), 0.0, 0.0, std::sin(pose.yaw / 2.0)};
+    dQuaternion q = {std::cos(pose.theta / 2.0), 0.0, 0.0, std::sin(pose.theta / 2.0)};
     dBodySetQuaternion(r.body.get(), q);
     dBodySetLinearVel(r.body.get(), 0, 0, 0);
     dBodySetAngularVel(r.body.get(), 0, 0, 0);
-    r.pose = Pose2D{pose.x, pose.y, normalizeAngle(pose.yaw)};
+    r.pose = Pose2D{pose.x, pose.y, normalizeAngle(pose.theta)};
     r.velocity = Twist2D{};
     r.setpoint = Twist2D{};
     r.command = Twist2D{};
@@ -654,7 +652,7 @@ struct World::Impl
     const std::string size_problem = checkShapeSizes(config.shape);
     if (!size_problem.empty()) throw SimError("obstacle " + config.name + ": " + size_problem);
     const Pose2D& pose = config.pose;
-    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw))
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
       throw SimError("obstacle " + config.name + ": the pose is not finite");
     if (!insideMap(pose.x, pose.y))
       throw SimError("obstacle " + config.name + " at " + formatPoint(pose.x, pose.y) + " is outside the map");
@@ -671,7 +669,7 @@ struct World::Impl
                      other->describe());
     o->tag.uid = next_uid++;
     o->geom = makeGeom(o->outline, 0.0, false);
-    setGeomPose(o->geom.get(), o->pose.x, o->pose.y, o->pose.yaw);
+    setGeomPose(o->geom.get(), o->pose.x, o->pose.y, o->pose.theta);
     dGeomSetCategoryBits(o->geom.get(), kWallBit);
     dGeomSetCollideBits(o->geom.get(), kRobotBit);
     dGeomSetData(o->geom.get(), &o->tag);
@@ -744,7 +742,7 @@ struct World::Impl
   void placeMover(Mover& m)
   {
     dBodySetPosition(m.body.get(), m.pose.x, m.pose.y, kBodyZ);
-    dQuaternion q = {std::cos(m.pose.yaw / 2.0), 0.0, 0.0, std::sin(m.pose.yaw / 2.0)};
+    dQuaternion q = {std::cos(m.pose.theta / 2.0), 0.0, 0.0, std::sin(m.pose.theta / 2.0)};
     dBodySetQuaternion(m.body.get(), q);
     dBodySetLinearVel(m.body.get(), m.vx, m.vy, 0.0);
     dBodySetAngularVel(m.body.get(), 0, 0, 0);
@@ -765,7 +763,7 @@ struct World::Impl
   void teleport(const std::string& name, const Pose2D& pose)
   {
     Robot& r = needRobot(name);
-    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw))
+    if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
       throw SimError("robot " + name + ": the pose is not finite");
     if (!insideMap(pose.x, pose.y))
       throw SimError("pose " + formatPoint(pose.x, pose.y) + " is outside the map");
@@ -850,7 +848,7 @@ struct World::Impl
     }
     // The robot-frame velocity in the map frame at the middle of the step: a constant
     // twist then moves the robot along the exact chord of its arc.
-    const double yaw_mid = r.pose.yaw + 0.5 * r.setpoint.wz * dt;
+    const double yaw_mid = r.pose.theta + 0.5 * r.setpoint.wz * dt;
     const double c = std::cos(yaw_mid), s = std::sin(yaw_mid);
     dBodySetLinearVel(r.body.get(), c * r.setpoint.vx - s * r.setpoint.vy, s * r.setpoint.vx + c * r.setpoint.vy, 0.0);
     dBodySetAngularVel(r.body.get(), 0.0, 0.0, r.setpoint.wz);
@@ -874,11 +872,11 @@ struct World::Impl
     dBodySetLinearVel(b, vx, vy, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, wz);
 
-    const double previous_yaw = r.pose.yaw;
+    const double previous_yaw = r.pose.theta;
     r.pose = Pose2D{p[0], p[1], normalizeAngle(2.0 * std::atan2(qz, qw))};
     // The robot-frame velocity over the step: rotate by the heading in the middle of the step,
     // as driveRobot() did, so that an unobstructed robot measures exactly its setpoint.
-    const double yaw_mid = previous_yaw + 0.5 * normalizeAngle(r.pose.yaw - previous_yaw);
+    const double yaw_mid = previous_yaw + 0.5 * normalizeAngle(r.pose.theta - previous_yaw);
     const double c = std::cos(yaw_mid), s = std::sin(yaw_mid);
     r.velocity = Twist2D{c * vx + s * vy, -s * vx + c * vy, wz};
   }
@@ -916,11 +914,11 @@ struct World::Impl
     }
     m.wz += r.faults.odom_drift;
 
-    const double yaw_mid = r.odom.yaw + 0.5 * m.wz * dt;
+    const double yaw_mid = r.odom.theta + 0.5 * m.wz * dt;
     const double c = std::cos(yaw_mid), s = std::sin(yaw_mid);
     r.odom.x += (c * m.vx - s * m.vy) * dt;
     r.odom.y += (s * m.vx + c * m.vy) * dt;
-    r.odom.yaw = normalizeAngle(r.odom.yaw + m.wz * dt);
+    r.odom.theta = normalizeAngle(r.odom.theta + m.wz * dt);
     r.odom_twist = m;
   }
 
@@ -1005,7 +1003,7 @@ struct World::Impl
       OrientedBox b;
       b.x = p.x;
       b.y = p.y;
-      b.yaw = p.yaw;
+      b.yaw = p.theta;
       b.half_length = outline.half_length;
       b.half_width = outline.half_width;
       b.owner = owner;
@@ -1025,11 +1023,11 @@ struct World::Impl
   void measureScan(Robot& r)
   {
     const auto& laser = r.model.laser;
-    const double c = std::cos(r.pose.yaw), s = std::sin(r.pose.yaw);
+    const double c = std::cos(r.pose.theta), s = std::sin(r.pose.theta);
     ScanSpec& spec = r.scan_spec;
     spec.x = r.pose.x + c * laser.mount_x - s * laser.mount_y;
     spec.y = r.pose.y + s * laser.mount_x + c * laser.mount_y;
-    spec.yaw = r.pose.yaw + laser.mount_yaw;
+    spec.yaw = r.pose.theta + laser.mount_yaw;
     castScan(grid, shapes, spec, r.scan.ranges);
     rays_cast += static_cast<unsigned long long>(spec.beams);
     r.scan.stamp = time();
@@ -1279,16 +1277,6 @@ std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& 
   auto fail = [&](const std::string& key, const std::string& problem) -> WorldConfigError {
     return WorldConfigError(config.file + ": " + key + ": " + problem);
   };
-  OccupancyMap map;
-  try
-  {
-    map = loadMap(config.map);
-  }
-  catch (const MapError& e)
-  {
-    throw fail("map", e.what());
-  }
-
   WorldSettings settings;
   settings.physics_step = config.physics_step;
   settings.seed = config.seed;
@@ -1297,7 +1285,7 @@ std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& 
   std::unique_ptr<World> world;
   try
   {
-    world = std::make_unique<World>(map, settings);
+    world = std::make_unique<World>(config.map_data, settings);
   }
   catch (const SimError& e)
   {

@@ -13,10 +13,6 @@ import rospy
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
 
 
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 class Recorder(object):
     """Subscribes to a topic and keeps every message with the sim time it arrived at."""
 
@@ -118,27 +114,15 @@ def drive_until(publisher, cmd, condition, sim_timeout, rate_hz=20.0, stop=True)
 
 
 def load_pgm_map(yaml_name):
-    """The fixture map as (occupied(ix, iy) -> bool, resolution, origin_x, origin_y, width, height).
-
-    Reads the map_server yaml and the binary PGM with the map_server rules (negate 0, p > occupied).
-    """
-    import yaml
-    from mbot_sim.map_io import read_pgm
-    with open(os.path.join(FIXTURES, yaml_name)) as f:
-        info = yaml.safe_load(f)
-    image = read_pgm(os.path.join(FIXTURES, info["image"]))  # top row first
-    height, width = image.shape
-    res = float(info["resolution"])
-    ox, oy = float(info["origin"][0]), float(info["origin"][1])
-    thresh = float(info["occupied_thresh"])
+    """The fixture map as (occupied(ix, iy) -> bool, resolution, origin_x, origin_y, width, height),
+    read by mbot_common.maps as map_server reads it (occupied: value 100)."""
+    from mbot_common.maps import OCCUPIED, load_map
+    m = load_map(os.path.join(FIXTURES, yaml_name))
 
     def occupied(ix, iy):
-        if ix < 0 or iy < 0 or ix >= width or iy >= height:
-            return False
-        value = int(image[height - 1 - iy, ix])  # map row 0 is the image's bottom row
-        return (255 - value) / 255.0 > thresh
+        return m.contains(ix, iy) and m.occupancy[iy, ix] == OCCUPIED
 
-    return occupied, res, ox, oy, width, height
+    return occupied, m.resolution, m.origin[0], m.origin[1], m.width, m.height
 
 
 def map_range(occupied, res, ox, oy, x, y, angle, max_range):

@@ -15,6 +15,7 @@ import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import Twist
+from mbot_common.geometry import yaw_of
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
@@ -24,7 +25,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 from sim_test_tools import (Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
-                            publish_for, wait_for_connection, yaw_of)
+                            publish_for, wait_for_connection)
 
 RADIUS = 0.15  # [m] mbot's footprint radius (urdf/mbot.urdf)
 

@@ -14,13 +14,14 @@ import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import Pose2D
+from mbot_common.geometry import yaw_of
 from mbot_msgs.srv import RemoveObstacle, SpawnObstacle
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import Recorder, load_pgm_map, map_range, wait_until, yaw_of  # noqa: E402
+from sim_test_tools import Recorder, load_pgm_map, map_range, wait_until  # noqa: E402
 
 BOX_X, BOX_Y = 3.5, 2.0              # [m] the box's centre, in front of robot_0
 BOX_LENGTH, BOX_WIDTH = 0.4, 0.6     # [m] its near face is at x = 3.3

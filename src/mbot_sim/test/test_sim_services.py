@@ -10,6 +10,7 @@ import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import Pose2D, Twist
+from mbot_common.geometry import yaw_of
 from mbot_msgs.srv import RemoveRobot, SetFault, SetFaultRequest, SpawnRobot, TeleportRobot
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
@@ -18,7 +19,7 @@ from std_srvs.srv import Empty
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 from sim_test_tools import (Recorder, drive_until, publish_for, wait_for_connection,  # noqa: E402
-                            wait_until, yaw_of)
+                            wait_until)
 
 
 def pose2d(x, y, theta):

@@ -144,12 +144,12 @@ TEST(Kinematics, DiffDriveArcMatchesTheAnalyticPose)
   const double R = v / w;
   EXPECT_NEAR(p.x, R * std::sin(w * T), 0.005);
   EXPECT_NEAR(p.y, R * (1.0 - std::cos(w * T)), 0.005);
-  EXPECT_NEAR(p.yaw, w * T, 0.005);
+  EXPECT_NEAR(p.theta, w * T, 0.005);
   // Without noise the odometry is the ground truth (both start at the same pose here).
   const Pose2D o = world.odometry(id);
   EXPECT_NEAR(o.x, p.x, 1e-6);
   EXPECT_NEAR(o.y, p.y, 1e-6);
-  EXPECT_NEAR(o.yaw, p.yaw, 1e-6);
+  EXPECT_NEAR(o.theta, p.theta, 1e-6);
 }
 
 TEST(Kinematics, DiffDriveIgnoresSidewaysCommands)
@@ -173,7 +173,7 @@ TEST(Kinematics, OmniDriveTranslatesAndTurnsAsAnalytic)
   const double s = std::sin(w * T), c = std::cos(w * T);
   EXPECT_NEAR(p.x, 1.0 + (vx * s + vy * (c - 1.0)) / w, 0.005);
   EXPECT_NEAR(p.y, -1.0 + (vx * (1.0 - c) + vy * s) / w, 0.005);
-  EXPECT_NEAR(p.yaw, w * T, 0.005);
+  EXPECT_NEAR(p.theta, w * T, 0.005);
   const Pose2D o = world.odometry(id);  // odom starts at identity: the displacement
   EXPECT_NEAR(o.x, p.x - 1.0, 1e-6);
   EXPECT_NEAR(o.y, p.y + 1.0, 1e-6);
@@ -311,7 +311,7 @@ TEST(Contacts, MovingObstacleFollowsItsPathAndCannotBePushed)
   // ping-pong: at 12 s it is back at x = 0, going towards -2
   run(world, 6.0);
   EXPECT_NEAR(world.obstacles().front().pose.x, 0.0, 1e-6);
-  EXPECT_NEAR(std::abs(world.obstacles().front().pose.yaw), kPi, 1e-9);
+  EXPECT_NEAR(std::abs(world.obstacles().front().pose.theta), kPi, 1e-9);
 }
 
 TEST(Contacts, LoopingMoverReturnsToTheFirstWaypoint)
@@ -329,7 +329,7 @@ TEST(Contacts, LoopingMoverReturnsToTheFirstWaypoint)
   Pose2D p = world.obstacles().front().pose;
   EXPECT_NEAR(p.x, 3.0, 1e-6);
   EXPECT_NEAR(p.y, 2.0, 1e-6);
-  EXPECT_NEAR(p.yaw, kPi / 2, 1e-9);
+  EXPECT_NEAR(p.theta, kPi / 2, 1e-9);
   run(world, 7.0);
   p = world.obstacles().front().pose;
   EXPECT_NEAR(p.x, 0.0, 1e-6);
@@ -426,7 +426,7 @@ Trace noisyRun(unsigned seed)
   for (int id : {a, b})
   {
     const Pose2D o = world.odometry(id);
-    t.values.insert(t.values.end(), {o.x, o.y, o.yaw});
+    t.values.insert(t.values.end(), {o.x, o.y, o.theta});
     for (float r : rec.scans[id].back().ranges) t.values.push_back(r);
   }
   return t;
@@ -548,8 +548,8 @@ TEST(Faults, OdometryDriftTurnsTheOdomFrame)
   f.odom_drift = 0.05;
   world.setFaults("robot_0", f);
   run(world, 2.0);
-  EXPECT_NEAR(world.odometry(id).yaw, 0.1, 1e-6);
-  EXPECT_NEAR(world.groundTruth(id).yaw, 0.0, 1e-9);
+  EXPECT_NEAR(world.odometry(id).theta, 0.1, 1e-6);
+  EXPECT_NEAR(world.groundTruth(id).theta, 0.0, 1e-9);
 }
 
 // ---- run-time requests ------------------------------------------------------------------------
@@ -580,7 +580,7 @@ TEST(Requests, SpawnTeleportRemoveAndTheirErrors)
   world.teleport("robot_1", Pose2D{5.0, 6.0, 1.0});
   world.step();
   EXPECT_NEAR(world.groundTruth(b).x, 5.0, 1e-9);
-  EXPECT_NEAR(world.groundTruth(b).yaw, 1.0, 1e-9);
+  EXPECT_NEAR(world.groundTruth(b).theta, 1.0, 1e-9);
   EXPECT_NEAR(world.odometry(b).x, 0.0, 1e-9);  // a kidnapping: the wheels did not turn
 
   FaultConfig bad;
@@ -696,7 +696,8 @@ TEST(Requests, ObstacleFromTheWorldFileCanBeRemoved)
 {
   WorldConfig config;
   config.file = "test.world.yaml";
-  config.map = kFixtures + "/room.yaml";
+  config.map = config.map_path = kFixtures + "/room.yaml";
+  config.map_data = roomMap();
   ObstacleConfig crate = box("crate_1", 1.0, 1.0, Pose2D{2.0, 2.0, 0.0});
   crate.key = "obstacles[0]";
   config.obstacles.push_back(crate);
@@ -806,7 +807,7 @@ TEST(Requests, ObstacleRequestShapesAsTheWorldFileReaderWordsThem)
   EXPECT_EQ(b.shape.type, ShapeConfig::Type::BOX);
   EXPECT_DOUBLE_EQ(b.shape.length, 0.5);
   EXPECT_DOUBLE_EQ(b.shape.width, 0.4);
-  EXPECT_DOUBLE_EQ(b.pose.yaw, 0.5);
+  EXPECT_DOUBLE_EQ(b.pose.theta, 0.5);
   const ObstacleConfig c = obstacleFromRequest("drum", "cylinder", 0.0, 0.0, 0.3, pose);
   EXPECT_EQ(c.shape.type, ShapeConfig::Type::CYLINDER);
   EXPECT_DOUBLE_EQ(c.shape.radius, 0.3);
@@ -833,10 +834,24 @@ TEST(Requests, ResetPutsRobotsBackAndZeroesOdometry)
   world.resetPositions();
   world.step();
   EXPECT_NEAR(world.groundTruth(id).x, 2.0, 1e-9);
-  EXPECT_NEAR(world.groundTruth(id).yaw, 0.3, 1e-9);
+  EXPECT_NEAR(world.groundTruth(id).theta, 0.3, 1e-9);
   EXPECT_NEAR(world.odometry(id).x, 0.0, 1e-9);
-  EXPECT_NEAR(world.odometry(id).yaw, 0.0, 1e-9);
+  EXPECT_NEAR(world.odometry(id).theta, 0.0, 1e-9);
   EXPECT_GT(world.time(), t);  // sim time goes on
+}
+
+// The fixture the wall and laser tests use (read by mbot_common::loadMap, tested there).
+TEST(Walls, RoomFixtureHasWallsAroundAndFreeInside)
+{
+  const OccupancyMap map = roomMap();
+  ASSERT_EQ(map.width, 200u);
+  ASSERT_EQ(map.height, 160u);
+  EXPECT_EQ(map.at(0, 0), 100);
+  EXPECT_EQ(map.at(1, 80), 100);     // x = 0.075 m: inside the 0.1 m west wall
+  EXPECT_EQ(map.at(2, 80), 0);       // x = 0.125 m: free
+  EXPECT_EQ(map.at(100, 80), 0);     // the middle
+  EXPECT_EQ(map.at(145, 30), 100);   // x = 7.25, y = 1.5: the wall block
+  EXPECT_EQ(map.at(145, 70), 0);     // x = 7.25, y = 3.5: above the block
 }
 
 TEST(Walls, MergedRectanglesCoverExactlyTheOccupiedCells)
@@ -876,7 +891,7 @@ TEST(RealModels, MbotOmniBoxBodyStrafesIntoAWallAndStopsAtIt)
   }
   EXPECT_GE(min_y - half_width, 0.1) << "the box body entered the wall";
   EXPECT_NEAR(world.groundTruth(id).y, 0.1 + half_width, 0.02);
-  EXPECT_NEAR(world.groundTruth(id).yaw, 0.0, 0.01);  // a flat face against a flat wall: no turn
+  EXPECT_NEAR(world.groundTruth(id).theta, 0.0, 0.01);  // a flat face against a flat wall: no turn
   EXPECT_EQ(rec.contactsBetween("omni", "map"), 1);
   // Its first scan (0.1 s, before it moved away sideways) saw the round robot 2 m ahead, from
   // the laser mount at laser.mount_x.

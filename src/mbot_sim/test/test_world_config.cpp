@@ -4,7 +4,6 @@
  *        each invalid_* fixture fails with a message naming the file, the key and the problem.
  */
 #include "mbot_sim/world.h"
-#include "mbot_sim/world_config.h"
 
 #include <gtest/gtest.h>
 
@@ -53,14 +52,15 @@ std::string worldError(const std::string& file)
 TEST(WorldConfig, ReadsEveryKey)
 {
   const WorldConfig c = mbot_sim::loadWorldConfig(kFixtures + "/full.world.yaml");
-  EXPECT_EQ(c.map, kFixtures + "/room.yaml");  // relative to the world file
+  EXPECT_EQ(c.map_path, kFixtures + "/room.yaml");  // relative to the world file
+  EXPECT_EQ(c.map_data.width, 200u);                 // loaded
   EXPECT_DOUBLE_EQ(c.physics_step, 0.005);
   EXPECT_DOUBLE_EQ(c.real_time_factor, 0.0);
   EXPECT_EQ(c.seed, 7u);
   ASSERT_EQ(c.robots.size(), 2u);
   EXPECT_EQ(c.robots[0].name, "leader");
   EXPECT_EQ(c.robots[1].model, "mbot_omni");
-  EXPECT_DOUBLE_EQ(c.robots[1].pose.yaw, -0.5);
+  EXPECT_DOUBLE_EQ(c.robots[1].pose.theta, -0.5);
   ASSERT_EQ(c.obstacles.size(), 2u);
   EXPECT_EQ(c.obstacles[0].shape.type, ShapeConfig::Type::BOX);
   EXPECT_DOUBLE_EQ(c.obstacles[0].shape.width, 0.4);

@@ -8,7 +8,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-import yaml
+from mbot_common.maps import FREE, OCCUPIED, load_map
+from mbot_common.world import load_world as read_world_file
 from scipy import ndimage
 
 from paths import MAPS_DIR, MODELS, URDF_DIR
@@ -19,55 +20,23 @@ WORLDS = MAIN_MAPS + ("bench_room",)
 CLEARANCE = 0.5       # [m] free space around each robot's footprint in a default world
 ROBOT_MARGIN = 0.05   # [m] beyond the footprint radius when asking whether a robot can pass
 
-# The keys of src/mbot_sim/WORLD_FORMAT.md.
-WORLD_KEYS = {"map", "physics_step", "real_time_factor", "seed", "robots", "obstacles",
-              "moving_obstacles", "noise", "faults"}
-ROBOT_KEYS = {"name", "model", "pose"}
-
-
-def read_pgm(path):
-    """A binary (P5) 8-bit PGM as a (rows, cols) uint8 array, top row first."""
-    with open(path, "rb") as f:
-        data = f.read()
-    tokens, pos = [], 0
-    while len(tokens) < 4:
-        if data[pos:pos + 1] == b"#":           # comment to the end of the line
-            pos = data.index(b"\n", pos) + 1
-        elif data[pos:pos + 1].isspace():
-            pos += 1
-        else:
-            end = pos
-            while not data[end:end + 1].isspace():
-                end += 1
-            tokens.append(data[pos:end])
-            pos = end
-    pos += 1                                      # one whitespace byte ends the header
-    assert tokens[0] == b"P5" and tokens[3] == b"255", tokens
-    width, height = int(tokens[1]), int(tokens[2])
-    pixels = np.frombuffer(data[pos:], dtype=np.uint8)
-    assert pixels.size == width * height, (path, pixels.size, width, height)
-    return pixels.reshape(height, width)
-
 
 class Map:
-    """A map_server map: ``free[iy, ix]`` with row 0 at the origin (as map_server flips it)."""
+    """A map_server map as the robots get it (mbot_common.maps.load_map, strict): ``free[iy, ix]``
+    with row 0 at the origin (as map_server flips it)."""
 
     def __init__(self, yaml_path):
-        with open(yaml_path) as f:
-            self.meta = yaml.safe_load(f)
-        image = read_pgm(os.path.join(os.path.dirname(yaml_path), self.meta["image"]))
-        p = (255.0 - np.flipud(image)) / 255.0    # negate 0
-        self.free = p < self.meta["free_thresh"]
-        self.occupied = p > self.meta["occupied_thresh"]
-        self.resolution = self.meta["resolution"]
-        self.origin = self.meta["origin"]
+        self.data = load_map(yaml_path)
+        self.free = self.data.occupancy == FREE
+        self.occupied = self.data.occupancy == OCCUPIED
+        self.resolution = self.data.resolution
+        self.origin = self.data.origin
         # Distance [m] from each cell centre to the nearest cell that is not free.
         self.distance = ndimage.distance_transform_edt(self.free) * self.resolution
 
     def cell(self, x, y):
-        ix = int(math.floor((x - self.origin[0]) / self.resolution))
-        iy = int(math.floor((y - self.origin[1]) / self.resolution))
-        assert 0 <= ix < self.free.shape[1] and 0 <= iy < self.free.shape[0], (x, y)
+        ix, iy = self.data.world_to_cell(x, y)
+        assert self.data.contains(ix, iy), (x, y)
         return iy, ix
 
     def clearance(self, x, y):
@@ -87,10 +56,14 @@ def footprint_radius(model):
 
 
 def load_world(name):
-    path = os.path.join(MAPS_DIR, name + ".world.yaml")
-    with open(path) as f:
-        world = yaml.safe_load(f)
-    return world, Map(os.path.join(MAPS_DIR, world["map"]))
+    """The world maps/NAME.world.yaml, read as strictly as stage_node reads it (mbot_common), and its map."""
+    world = read_world_file(os.path.join(MAPS_DIR, name + ".world.yaml"))
+    return world, Map(world.map_path)
+
+
+def outer_radius(shape):
+    """[m] the circle around an obstacle's shape: half a box's diagonal, a cylinder's radius."""
+    return math.hypot(shape.length, shape.width) / 2 if shape.type == "box" else shape.radius
 
 
 def segment_distance(p, a, b):
@@ -99,10 +72,10 @@ def segment_distance(p, a, b):
     return float(np.linalg.norm(ap - t * ab))
 
 
-def path_segments(obstacle):
-    points = obstacle["waypoints"]
+def path_segments(mover):
+    points = mover.waypoints
     pairs = list(zip(points[:-1], points[1:]))
-    if obstacle.get("mode", "loop") == "loop":
+    if mover.mode == "loop":
         pairs.append((points[-1], points[0]))
     return pairs
 
@@ -119,13 +92,11 @@ def test_every_map_has_a_yaml_and_nothing_else_is_there():
 @pytest.mark.parametrize("name", ALL_MAPS)
 def test_map_yaml_loads_and_matches_its_pgm(name):
     m = Map(os.path.join(MAPS_DIR, name + ".yaml"))
-    assert set(m.meta) == {"image", "resolution", "origin", "occupied_thresh", "free_thresh",
-                           "negate"}
-    assert m.meta["image"] == name + ".pgm"
+    assert m.data.image_path == os.path.join(MAPS_DIR, name + ".pgm")
     assert m.resolution == 0.05
-    assert m.meta["occupied_thresh"] == 0.65 and m.meta["free_thresh"] == 0.196
-    assert m.meta["negate"] == 0
-    assert len(m.origin) == 3 and m.origin[2] == 0.0
+    assert m.data.occupied_thresh == 0.65 and m.data.free_thresh == 0.196
+    assert not m.data.negate and m.data.mode == "trinary"
+    assert m.origin[2] == 0.0
     rows, cols = m.free.shape
     assert cols * m.resolution <= 60.0 and rows * m.resolution <= 60.0   # small PGMs
     # The map is centred on the map frame's origin.
@@ -181,68 +152,61 @@ def test_maps_are_up_to_date_with_their_generator():
 
 
 @pytest.mark.parametrize("name", WORLDS)
-def test_world_uses_known_keys_and_unique_names(name):
+def test_world_reads_strictly_with_known_models(name):
+    # the reader refuses unknown keys, wrong types and names used twice
     world, _ = load_world(name)
-    assert set(world) <= WORLD_KEYS
-    robots = world["robots"]
+    robots = world.robots
     assert len(robots) == (1 if name == "bench_room" else 3)
     for robot in robots:
-        assert set(robot) <= ROBOT_KEYS
-        assert robot.get("model", "mbot") in MODELS
-        assert len(robot["pose"]) == 3
+        assert robot.model in MODELS
     if name != "bench_room":
-        assert [r["name"] for r in robots] == ["robot_0", "robot_1", "robot_2"]
-    everything = robots + world.get("obstacles", []) + world.get("moving_obstacles", [])
-    named = [item["name"] for item in everything if "name" in item]
-    assert len(named) == len(set(named))
+        assert [r.name for r in robots] == ["robot_0", "robot_1", "robot_2"]
 
 
 @pytest.mark.parametrize("name", WORLDS)
 def test_robots_stand_free_with_clearance(name):
     world, m = load_world(name)
-    robots = world["robots"]
-    radius = {r["name"]: footprint_radius(r.get("model", "mbot")) for r in robots}
+    robots = world.robots
+    radius = {r.name: footprint_radius(r.model) for r in robots}
     for robot in robots:
-        x, y, _ = robot["pose"]
-        r = radius[robot["name"]]
-        assert m.free[m.cell(x, y)], robot["name"]
-        assert m.clearance(x, y) - r >= CLEARANCE, (robot["name"], m.clearance(x, y) - r)
+        x, y = robot.pose.x, robot.pose.y
+        r = radius[robot.name]
+        assert m.free[m.cell(x, y)], robot.name
+        assert m.clearance(x, y) - r >= CLEARANCE, (robot.name, m.clearance(x, y) - r)
         for other in robots:
             if other is not robot:
-                gap = math.dist((x, y), other["pose"][:2]) - r - radius[other["name"]]
-                assert gap >= CLEARANCE, (robot["name"], other["name"], gap)
-        for obstacle in world.get("obstacles", []):
-            size = obstacle.get("size")
-            obstacle_r = math.hypot(*size) / 2 if size else obstacle["radius"]
-            gap = math.dist((x, y), obstacle["pose"][:2]) - r - obstacle_r
-            assert gap >= CLEARANCE, (robot["name"], obstacle.get("name"), gap)
-        for mover in world.get("moving_obstacles", []):
+                gap = math.dist((x, y), (other.pose.x, other.pose.y)) - r - radius[other.name]
+                assert gap >= CLEARANCE, (robot.name, other.name, gap)
+        for obstacle in world.obstacles:
+            gap = math.dist((x, y), (obstacle.pose.x, obstacle.pose.y)) - r - outer_radius(obstacle.shape)
+            assert gap >= CLEARANCE, (robot.name, obstacle.name, gap)
+        for mover in world.moving_obstacles:
             path = min(segment_distance((x, y), a, b) for a, b in path_segments(mover))
-            gap = path - r - mover["radius"]
-            assert gap >= CLEARANCE, (robot["name"], mover.get("name"), gap)
+            gap = path - r - outer_radius(mover.shape)
+            assert gap >= CLEARANCE, (robot.name, mover.name, gap)
 
 
 @pytest.mark.parametrize("name", WORLDS)
 def test_obstacles_are_in_free_space(name):
     world, m = load_world(name)
-    for obstacle in world.get("obstacles", []):
-        assert m.free[m.cell(*obstacle["pose"][:2])]
-    for mover in world.get("moving_obstacles", []):
+    for obstacle in world.obstacles:
+        assert m.free[m.cell(obstacle.pose.x, obstacle.pose.y)]
+    for mover in world.moving_obstacles:
         for a, b in path_segments(mover):
             steps = int(math.dist(a, b) / m.resolution) + 1
             for t in np.linspace(0.0, 1.0, steps + 1):
                 x, y = np.add(a, t * np.subtract(b, a))
-                assert m.clearance(x, y) >= mover["radius"], (mover.get("name"), x, y)
+                assert m.clearance(x, y) >= outer_radius(mover.shape), (mover.name, x, y)
 
 
 def test_office_world_has_a_walking_person_and_a_box():
     world, _ = load_world("office")
-    assert [o["shape"] for o in world["obstacles"]] == ["box"]
-    (person,) = world["moving_obstacles"]
-    assert person["mode"] == "loop" and person["speed"] > 0 and len(person["waypoints"]) >= 3
+    assert [o.shape.type for o in world.obstacles] == ["box"]
+    (person,) = world.moving_obstacles
+    assert person.mode == "loop" and person.speed > 0 and len(person.waypoints) >= 3
 
 
 def test_corridor_world_puts_robots_at_both_ends():
     world, _ = load_world("corridor")
-    xs = [r["pose"][0] for r in world["robots"]]
+    xs = [r.pose.x for r in world.robots]
     assert min(xs) < -10.0 and max(xs) > 10.0     # the corridor runs from x = -10 to 10

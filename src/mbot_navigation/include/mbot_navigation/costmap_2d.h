@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <mbot_common/geometry.h>
+
 namespace mbot_navigation
 {
 /// Cost values, as in costmap_2d/cost_values.h.
@@ -23,13 +25,8 @@ constexpr uint8_t LETHAL = 254;     ///< an obstacle
 constexpr uint8_t NO_INFORMATION = 255;
 }  // namespace cost
 
-/// @brief A planar pose [m, m, rad].
-struct Pose2D
-{
-  double x = 0.0;
-  double y = 0.0;
-  double theta = 0.0;
-};
+/// @brief A planar pose {x [m], y [m], theta [rad]}: mbot_common's, shared by every package.
+using mbot_common::Pose2D;
 
 /// @brief A rectangular grid of costs with a resolution [m/cell] and an origin [m] in its frame.
 class Costmap2D

@@ -34,7 +34,7 @@ public:
 
   /**
    * @brief Take a new map. Arguments are plain fields so that nav_msgs/OccupancyGrid and
-   *        mbot_sim::OccupancyMap both pass without a copy into another struct. Add the layer to
+   *        mbot_common::OccupancyMap both pass without a copy into another struct. Add the layer to
    *        its LayeredCostmap first: a static costmap then takes the map's size and origin.
    * @param width, height [cells]; @param resolution [m/cell]; @param origin_x, origin_y lower-left
    *        corner of cell (0, 0) [m] (rotation is ignored, as costmap_2d does)

@@ -10,18 +10,16 @@
 
 #include <vector>
 
+#include <mbot_common/geometry.h>
+
 #include "mbot_navigation/costmap_2d.h"
 
 namespace mbot_navigation
 {
-/// @brief A planar velocity in the robot's frame [m/s, m/s, rad/s] (geometry_msgs/Twist's
+/// @brief A planar velocity in the robot's frame: mbot_common's {vx [m/s] forward, vy [m/s] to
+///        the left (omni robots only), wz [rad/s] counter-clockwise} (geometry_msgs/Twist's
 ///        linear.x, linear.y and angular.z).
-struct Twist2D
-{
-  double x = 0.0;      ///< forward [m/s]
-  double y = 0.0;      ///< to the left [m/s] (omni robots only)
-  double theta = 0.0;  ///< counter-clockwise [rad/s]
-};
+using mbot_common::Twist2D;
 
 /// @brief One velocity sample held for `sim_time`, and the poses the robot would pass through.
 struct Trajectory

@@ -64,12 +64,6 @@ struct StageParams
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
 StageParams readStageParams(const ros::NodeHandle& private_nh);
 
-/// @brief Find the world file for `world`: a path (contains '/' or ends in .yaml) as it is,
-///        else NAME.world.yaml in `maps_dir`, then in the workspace maps/ directory next to
-///        src/ (found from the mbot_sim package path), then in mbot_sim's share/maps.
-/// @throws StartupError naming the places searched
-std::string resolveWorldPath(const std::string& world, const std::string& maps_dir);
-
 /// @brief stage_node: one World, its topics, tf and services.
 class StageRos : public SensorListener
 {

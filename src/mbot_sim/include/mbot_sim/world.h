@@ -20,9 +20,9 @@
  */
 #pragma once
 
-#include "mbot_sim/map_io.h"
-#include "mbot_sim/world_config.h"
-
+#include <mbot_common/geometry.h>
+#include <mbot_common/map_io.h>
+#include <mbot_common/world_file.h>
 #include <mbot_description/robot_model.h>
 
 #include <functional>
@@ -33,20 +33,33 @@
 
 namespace mbot_sim
 {
+// The plain types of the world are mbot_common's: geometry (Pose2D {x, y, theta}, Twist2D
+// {vx, vy, wz}), the map (map_io.h) and the world file's structs and reader (world_file.h).
+using mbot_common::Point2D;
+using mbot_common::Pose2D;
+using mbot_common::Twist2D;
+using mbot_common::loadMap;
+using mbot_common::MapError;
+using mbot_common::OccupancyMap;
+using mbot_common::checkFaults;
+using mbot_common::checkName;
+using mbot_common::FaultConfig;
+using mbot_common::loadWorldConfig;
+using mbot_common::MovingObstacleConfig;
+using mbot_common::NoiseConfig;
+using mbot_common::ObstacleConfig;
+using mbot_common::RobotConfig;
+using mbot_common::RobotFaultConfig;
+using mbot_common::ShapeConfig;
+using mbot_common::WorldConfig;
+using mbot_common::WorldConfigError;
+
 /// @brief Raised by run-time requests that cannot be done (unknown robot, pose inside a wall,
 ///        duplicate name...); the message says why. The world is unchanged when it is raised.
 class SimError : public std::runtime_error
 {
 public:
   using std::runtime_error::runtime_error;
-};
-
-/// @brief A planar velocity in the robot's frame.
-struct Twist2D
-{
-  double vx = 0.0;  ///< forward [m/s]
-  double vy = 0.0;  ///< left [m/s] (omni robots only)
-  double wz = 0.0;  ///< counter-clockwise [rad/s]
 };
 
 /// @brief Odometry: the pose in the robot's odom frame (identity at start and after a reset),
@@ -218,11 +231,11 @@ ObstacleConfig obstacleFromRequest(const std::string& name, const std::string& s
 /// @brief Loads a robot model by name (e.g. with mbot_description::loadRobotModel).
 using ModelLoader = std::function<mbot_description::RobotModel(const std::string& model)>;
 
-/// @brief Build the world a world file describes: map, obstacles, moving obstacles, robots,
-///        faults. Geometry errors name the file and the key, e.g.
+/// @brief Build the world a world file describes: map (config.map_data, loaded by the reader),
+///        obstacles, moving obstacles, robots, faults. Geometry errors name the file and the key, e.g.
 ///        `office.world.yaml: robots[1].pose: robot_1 at (1.00, 2.00) overlaps a wall`.
-/// @throws WorldConfigError for a missing or invalid map, an unknown model, a body overlapping
-///         another
+/// @throws WorldConfigError for a map stage_node cannot use (rotated), an unknown model, a body
+///         overlapping another
 std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& load_model,
                                   double watchdog_timeout = 0.2);
 
