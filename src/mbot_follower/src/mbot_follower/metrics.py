@@ -19,7 +19,8 @@ What the numbers mean (all times sim time unless marked wall):
   fit error         the same after the best rigid fit (rotation + translation) of the desired
                     shape onto the actual positions (shape.rigid_fit): the shape alone.
   steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED.
-  leader lateral    distance of the leader from the polyline of its current global plan; the
+  leader lateral    distance of the leader from the polyline of its global plan (the newest one not
+                    later than the leader's pose; a new goal, FORMING, forgets the old plans); the
                     summary counts it while the leader follows the plan (NAVIGATING, DEGRADED).
   latency           FollowerState header.stamp (command computed) - pose_stamp (the tf pose it
                     used) + one physics step (`physics_step`): the simulator applies a command at
@@ -154,7 +155,12 @@ class MetricsCollector(object):
         self.distance = {}       # robot -> path length so far [m]
         self.energy = {}         # robot -> energy so far [J]
         self.power = {}          # robot -> (t, power [W]) of the newest power message
-        self.plans = {}          # robot -> (n, 2) array: its newest global plan in map
+        self.plans = {}          # robot -> [(t, (n, 2) array or None)]: its global plans in map, in arrival order
+        # (t, assignment) and (t, state, lost) in arrival order: a sample at t uses the newest
+        # one not later than t. A message stamped after the sample time may arrive before the
+        # pose that triggers the sample (the coordinator sends a new assignment, then its status).
+        self._assignments = []
+        self._statuses = []
         self._next_tick = None   # the next sample is at _next_tick / rate [s]
 
     def _know(self, robot):
@@ -190,6 +196,7 @@ class MetricsCollector(object):
         """A new slot assignment (leader, formation, spacing, slots {robot: (x, y)} in the leader frame)."""
         old = self.assignment
         self.assignment = assignment
+        self._assignments.append((t, assignment))
         for robot in [assignment.leader] + sorted(assignment.slots):
             self._know(robot)
         slots = " ".join("%s(%g,%g)" % (r, assignment.slots[r][0], assignment.slots[r][1])
@@ -204,7 +211,13 @@ class MetricsCollector(object):
         if state != self.state:
             self.run.events.append(Event(t, "state", state, reason, NAN, NAN))
             self.state = state
+            if state == "FORMING":
+                # A new goal: the plans of the old one no longer say where the leader should
+                # drive; the lateral error waits for the new goal's plan.
+                for plans in self.plans.values():
+                    plans.append((t, None))
         lost = tuple(lost)
+        self._statuses.append((t, state, lost))
         for robot in lost:
             if robot not in self.lost:
                 self.run.events.append(Event(t, "loss", robot, "", NAN, NAN))
@@ -235,21 +248,38 @@ class MetricsCollector(object):
     def on_plan(self, robot, t, points):
         """A robot's global plan in map: points (n, 2); an empty plan clears it."""
         points = np.asarray(points, dtype=float).reshape(-1, 2)
-        self.plans[robot] = points if len(points) else None
+        self.plans.setdefault(robot, []).append((t, points if len(points) else None))
 
     # --- one sample -----------------------------------------------------------------------
 
+    @staticmethod
+    def _in_force(history, t):
+        """The newest entry of history (tuples starting with their time) not later than t, or
+        None; older entries are dropped (samples come in time order)."""
+        current = None
+        for k, entry in enumerate(history):
+            if entry[0] <= t + 1e-9 and (current is None or entry[0] >= history[current][0]):
+                current = k
+        if current is None:
+            return None
+        del history[:current]
+        return history[0]
+
     def sample(self, t):
-        """A Sample of the fleet at t from the newest fresh pose of every robot."""
+        """A Sample of the fleet at t from the newest fresh pose of every robot, with the
+        assignment and the status in force at t."""
         fresh = {r: p[1:] for r, p in self.poses.items() if t - p[0] <= self.config.stale_after}
-        a = self.assignment
+        entry = self._in_force(self._assignments, t)
+        a = entry[1] if entry is not None else None
+        entry = self._in_force(self._statuses, t)
+        state, lost = (entry[1], entry[2]) if entry is not None else ("", ())
         slot_error, fit_error = {}, {}
         errors = ShapeErrors(NAN, NAN, NAN, NAN, NAN, NAN)   # no follower measured
         lateral = NAN
         leader = a.leader if a is not None else ""
-        if a is not None and leader in fresh and leader not in self.lost:
+        if a is not None and leader in fresh and leader not in lost:
             lx, ly, lth = fresh[leader]
-            followers = sorted(r for r in a.slots if r != leader and r not in self.lost and r in fresh)
+            followers = sorted(r for r in a.slots if r != leader and r not in lost and r in fresh)
             if followers:
                 actual = [(lx, ly)] + [fresh[r][:2] for r in followers]
                 desired = [transform_point((lx, ly, lth), *a.slots.get(leader, (0.0, 0.0)))]
@@ -259,9 +289,12 @@ class MetricsCollector(object):
                 for i, r in enumerate(followers, start=1):
                     slot_error[r] = math.hypot(actual[i][0] - desired[i][0], actual[i][1] - desired[i][1])
                     fit_error[r] = math.hypot(actual[i][0] - fitted[i][0], actual[i][1] - fitted[i][1])
-            plan = self.plans.get(leader)
-            if plan is not None:
-                lateral = distance_to_polyline(lx, ly, plan)
+            # The plan in force when the leader was where its pose says: under load the 100 Hz
+            # ground truth may lag behind the plans, and a plan that starts ahead of an old pose
+            # is not the leader's lateral error.
+            entry = self._in_force(self.plans.get(leader, []), self.poses[leader][0])
+            if entry is not None and entry[1] is not None:
+                lateral = distance_to_polyline(lx, ly, entry[1])
         clearance, pair = NAN, ""
         names = sorted(fresh)
         for i, r in enumerate(names):
@@ -274,7 +307,7 @@ class MetricsCollector(object):
             x, y, theta = fresh.get(r, (NAN, NAN, NAN))
             robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN),
                                     self.distance[r], self.energy[r])
-        return Sample(t, self.state, leader, a.formation if a is not None else "", self.lost,
+        return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)
 

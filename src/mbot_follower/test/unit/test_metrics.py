@@ -116,8 +116,63 @@ def test_leader_lateral_error_counts_while_navigating_on_the_current_plan():
     assert s["fleet"]["leader_lateral_rms_m"] == pytest.approx(math.sqrt((0.2 ** 2 + 0.5 ** 2) / 2))
     assert s["fleet"]["leader_lateral_max_m"] == pytest.approx(0.5)
     assert c.run.samples[-1].leader_lateral == pytest.approx(math.hypot(4.0, 4.0))  # recorded, not counted
-    c.on_plan("robot_0", 6.0, [])   # an empty plan clears it
+    c.on_plan("robot_0", 5.9, [])   # an empty plan clears it (from its time: the leader's last pose is at 5.98 s)
     assert math.isnan(c.sample(6.0).leader_lateral)
+
+
+def test_a_new_goal_forgets_the_old_goals_plan():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    c.on_plan("robot_0", 0.0, [(0.0, 0.0), (5.0, 0.0)])
+    c.on_status(1.0, "ARRIVED", "at the target", [])
+    c.on_status(2.0, "FORMING", "a new target", [])
+    c.on_status(3.0, "NAVIGATING", "formation reached", [])
+
+    def at(t):
+        if near(t, 5.0):   # the new goal's plan comes late (a busy nav node)
+            c.on_plan("robot_0", t, [(0.0, 2.0), (0.0, 9.0)])
+
+    # the leader drives north on the new goal's way, 2 m away from the old plan
+    drive(c, 3.0, 7.0, lambda t: {"robot_0": (0.0, 2.0 + 0.5 * (t - 3.0), 1.57), "robot_1": (0.0, 1.0, 1.57)}, at)
+    lateral = [s.leader_lateral for s in c.run.samples]
+    assert all(math.isnan(v) for v in lateral[:19])        # 3.0 .. 4.9 s: no plan for this goal yet
+    assert max(lateral[21:]) < 1e-9                         # on the new plan
+    assert summarize(c.run)["fleet"]["leader_lateral_max_m"] < 1e-9
+
+
+def test_a_sample_uses_the_assignment_and_status_in_force_at_its_time():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge())
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    still = {"robot_0": (0.0, 0.0, 0.0), "robot_1": (-1.0, 0.5, 0.0), "robot_2": (-1.0, -0.5, 0.0)}
+    drive(c, 0.0, 1.98, lambda t: still)            # in their wedge slots: the sample at 1.9 s is the last
+    # robot_1 is lost at 2.05 s: the new assignment (robot_2 in robot_1's slot) and then the status
+    # arrive before the pose that takes the sample at 2.0 s
+    c.on_assignment(2.05, wedge({"robot_0": (0.0, 0.0), "robot_2": (-1.0, 0.5)}))
+    c.on_status(2.05, "DEGRADED", "lost robot_1", ["robot_1"])
+    drive(c, 2.0, 2.2, lambda t: still)
+    at_2, at_21 = c.run.samples[-2], c.run.samples[-1]
+    assert (at_2.t, at_2.state, at_2.formation, at_2.lost) == (2.0, "NAVIGATING", "wedge", ())
+    assert at_2.robots["robot_2"].slot_error == pytest.approx(0.0)     # still its old slot
+    assert (at_21.t, at_21.state, at_21.lost) == (pytest.approx(2.1), "DEGRADED", ("robot_1",))
+    assert at_21.robots["robot_2"].slot_error == pytest.approx(1.0)    # the new slot, 1 m away
+    assert math.isnan(at_21.robots["robot_1"].slot_error)
+
+
+def test_the_lateral_error_uses_the_plan_of_the_leaders_pose_time():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    c.on_plan("robot_0", 0.0, [(0.0, 0.0), (9.0, 0.0)])
+    drive(c, 0.0, 1.0, lambda t: {"robot_0": (0.5 * t, 0.0, 0.0), "robot_1": (0.5 * t - 1.0, 0.0, 0.0)})
+    # the leader's ground truth lags (a busy collector): its plans of 1.5 s and 2 s, starting where
+    # it is then, arrive while its newest pose is still the one of 0.98 s (x = 0.49 m)
+    c.on_plan("robot_0", 1.5, [(0.75, 0.0), (9.0, 0.0)])
+    c.on_plan("robot_0", 2.0, [(1.0, 0.0), (9.0, 0.0)])
+    assert c.sample(1.1).leader_lateral == pytest.approx(0.0)   # the plan of 0 s: on it
+    c.on_pose("robot_0", 2.0, 1.0, 0.3, 0.0)                     # then a pose of 2 s, 0.3 m aside
+    assert c.sample(2.0).leader_lateral == pytest.approx(0.3)
 
 
 def test_latency_tf_success_rate_and_cycle_time():
