@@ -23,6 +23,7 @@ import json
 import os
 import sys
 
+from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_data import METRIC_BY_KEY, METRICS, STATES, LabCriteria, ReportError, arrival_time, \
     assignments, compare_rows, evaluate, format_value, parse_criteria, run_numbers, sorted_events, \
     switch_settling, target_time
@@ -303,7 +304,7 @@ def render_images(inputs, image_dir, animation=True):
     if not os.path.isdir(image_dir):
         os.makedirs(image_dir)
     run, radius = inputs.run, inputs.run.config.robot_radius
-    colors = plots.robot_colors(run.robots, [r.name for r in inputs.world.robots])
+    colors = robot_colors(run.robots, [r.name for r in inputs.world.robots])
     out = {}
     out["trajectories.png"] = plots.plot_trajectories(run, inputs.world, colors,
                                                       os.path.join(image_dir, "trajectories.png"), radius)
@@ -384,7 +385,7 @@ def write_compare_report(run_a, run_b, out_dir=None):
         os.makedirs(image_dir)
     names = ["A", "B"]
     for name, inputs in zip(names, (a, b)):
-        colors = plots.robot_colors(inputs.run.robots, [r.name for r in inputs.world.robots])
+        colors = robot_colors(inputs.run.robots, [r.name for r in inputs.world.robots])
         plots.plot_trajectories(inputs.run, inputs.world, colors, os.path.join(image_dir, "trajectories_%s.png" % name),
                                 inputs.run.config.robot_radius)
     plots.plot_compare_errors([a.run, b.run], names, os.path.join(image_dir, "errors_compare.png"),

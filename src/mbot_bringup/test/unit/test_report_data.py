@@ -9,7 +9,8 @@ import pytest
 from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, assignment_at, assignments, \
     compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, speeds, \
     switch_settling
-from mbot_bringup.report_plots import error_limit, robot_colors, snapshot_indices
+from mbot_bringup.colors import robot_colors
+from mbot_bringup.report_plots import error_limit, snapshot_indices
 from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize
 
 FIXTURE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "run_trio")
