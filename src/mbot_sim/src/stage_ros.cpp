@@ -80,7 +80,7 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   pnh.param("lockstep_active_timeout", p.lockstep_active_timeout, 0.5);
   if (!(p.lockstep_active_timeout > 0.0))
     throw StartupError(pnh.resolveName("lockstep_active_timeout") + ": expected a number > 0 [s]");
-  pnh.param("lockstep_wall_timeout", p.lockstep_wall_timeout, 0.5);
+  pnh.param("lockstep_wall_timeout", p.lockstep_wall_timeout, 2.0);
   if (!(p.lockstep_wall_timeout > 0.0))
     throw StartupError(pnh.resolveName("lockstep_wall_timeout") + ": expected a number > 0 [s]");
   pnh.param("lockstep_localization_lag", p.lockstep_localization_lag, 0.1);

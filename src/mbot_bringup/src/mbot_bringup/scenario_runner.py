@@ -662,7 +662,9 @@ def run(args):
         import rospy
 
         end = time.time() + 60.0
-        while not rosgraph.Master("/scenario_runner").is_online():
+        # rospy reads /use_sim_time once, in init_node: wait until roslaunch has set it, or the
+        # runner would keep wall time while everything else runs on sim time.
+        while not _sim_time_set(rosgraph):
             if not launch.alive() or time.time() > end:
                 say("error: the fleet did not start; the end of %s:\n%s" % (launch.log_path, launch.tail()))
                 return 3
@@ -722,6 +724,14 @@ def parse_args(argv):
     parser.add_argument("--real-time", action="store_true", help="real_time_factor 1 without lockstep (to watch it)")
     parser.add_argument("--list", action="store_true", help="list the scenarios and exit")
     return parser.parse_args(argv)
+
+
+def _sim_time_set(rosgraph):
+    """True once the master is up and /use_sim_time is true."""
+    try:
+        return rosgraph.Master("/scenario_runner").getParam("/use_sim_time") is True
+    except Exception:  # noqa: B902 (no master yet, or the parameter is not set yet)
+        return False
 
 
 def main(argv=None):

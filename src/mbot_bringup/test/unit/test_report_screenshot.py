@@ -1,5 +1,5 @@
-"""scripts/screenshot (rviz/fleet.rviz under Xvfb, captured by mbot_bringup.screenshot) of a
-running trio world: the PNG is not blank, and each robot's marker colour appears where the robot
+"""scripts/screenshot (the fleet view fleet_rviz writes for trio, under Xvfb, captured by
+mbot_bringup.screenshot) of a running trio world: the PNG is not blank, and each robot's marker colour appears where the robot
 stands.
 
 Starts its own ROS master on a free port, the simulator (mbot_sim sim.launch world:=trio) and the
@@ -7,7 +7,7 @@ map server (empty map), and stops them by PID at the end. Skips when ROS, Xvfb, 
 ImageMagick's import is missing.
 
 Where a robot should appear: rviz's top-down view shows the map square (20 m x 20 m, walls and
-free cells in two greys) at 33 px/m (fleet.rviz "Scale"); its bounding box in the image gives the
+free cells in two greys) at the view's "Scale" [px/m]; its bounding box in the image gives the
 map frame, so robot (x, y) belongs at left + (x - x0) * s, bottom - (y - y0) * s.
 """
 import os
@@ -19,7 +19,9 @@ import time
 
 import numpy as np
 import pytest
+import yaml
 
+from mbot_bringup.fleet_rviz import write_fleet_view
 from mbot_bringup.screenshot import looks_rendered
 from mbot_common.paths import resolve_world
 from mbot_common.world import load_world
@@ -31,7 +33,6 @@ MISSING = [p for p in NEEDED if shutil.which(p) is None]
 BACKGROUND = 48.0          # fleet.rviz "Background Color" 48; 48; 48
 MAP_ALPHA = 0.7            # fleet.rviz Map "Alpha"
 MARKER_ALPHA = 0.9         # stage_node's robot markers
-SCALE = 33.0               # fleet.rviz "Scale" [px/m]
 
 pytestmark = pytest.mark.skipif(bool(MISSING), reason="not installed: %s" % ", ".join(MISSING))
 
@@ -73,7 +74,8 @@ def wait_for(what, check, seconds):
 
 @pytest.fixture(scope="module")
 def trio_screenshot(tmp_path_factory):
-    """(path of the PNG, the trio world) of scripts/screenshot against a running trio world."""
+    """(path of the PNG, the trio world, the view's scale [px/m]) of scripts/screenshot against a
+    running trio world."""
     tmp = tmp_path_factory.mktemp("screenshot")
     env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % free_port(), ROS_LOG_DIR=str(tmp / "logs"))
     port = env["ROS_MASTER_URI"].rsplit(":", 1)[1]
@@ -95,31 +97,35 @@ def trio_screenshot(tmp_path_factory):
             return "/stage/markers" in out and "/map" in out
         wait_for("/stage/markers and /map", published, 120)
         png = str(tmp / "trio.png")
-        shot = subprocess.run([os.path.join(ROOT, "scripts", "screenshot"), png, "--wait", "10"], env=env,
+        view = write_fleet_view("trio", str(tmp / "trio.rviz"))
+        with open(view) as f:
+            scale = float(yaml.safe_load(f)["Visualization Manager"]["Views"]["Current"]["Scale"])
+        shot = subprocess.run([os.path.join(ROOT, "scripts", "screenshot"), png, "--config", view, "--wait", "10"],
+                              env=env,
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=300)
         assert shot.returncode == 0, shot.stdout
-        return png, world
+        return png, world, scale
     finally:
         for p in reversed(processes):
             stop(p)
         log.close()
 
 
-def map_box(image, map_data):
+def map_box(image, map_data, scale):
     """(left, right, top, bottom) [px] of the map square: columns and rows where most pixels have
     the colour of a free or an occupied cell under the map's alpha."""
     free = MAP_ALPHA * 254.0 + (1 - MAP_ALPHA) * BACKGROUND
     wall = (1 - MAP_ALPHA) * BACKGROUND
     grey = (np.abs(image - image[..., :1]).max(axis=2) <= 2)
     is_map = grey & ((np.abs(image[..., 0] - free) <= 3) | (np.abs(image[..., 0] - wall) <= 3))
-    cols = np.flatnonzero(is_map.sum(axis=0) > 0.5 * map_data.height * map_data.resolution * SCALE)
-    rows = np.flatnonzero(is_map.sum(axis=1) > 0.5 * map_data.width * map_data.resolution * SCALE)
+    cols = np.flatnonzero(is_map.sum(axis=0) > 0.5 * map_data.height * map_data.resolution * scale)
+    rows = np.flatnonzero(is_map.sum(axis=1) > 0.5 * map_data.width * map_data.resolution * scale)
     return cols[0], cols[-1] + 1, rows[0], rows[-1] + 1
 
 
 def test_the_screenshot_is_rendered(trio_screenshot):
     from PIL import Image
-    png, _ = trio_screenshot
+    png, _, _ = trio_screenshot
     assert looks_rendered(png)
     image = Image.open(png).convert("RGB")
     assert image.size == (1200, 846)                   # scripts/common.sh start_xvfb: 1200x846
@@ -128,13 +134,13 @@ def test_the_screenshot_is_rendered(trio_screenshot):
 
 def test_each_robots_colour_is_where_the_robot_is(trio_screenshot):
     from PIL import Image
-    png, world = trio_screenshot
+    png, world, view_scale = trio_screenshot
     image = np.asarray(Image.open(png).convert("RGB"), dtype=float)
     map_data = world.map_data
-    left, right, top, bottom = map_box(image, map_data)
+    left, right, top, bottom = map_box(image, map_data, view_scale)
     scale = (right - left) / (map_data.width * map_data.resolution)
-    assert scale == pytest.approx(SCALE, rel=0.03)
-    assert (bottom - top) / (map_data.height * map_data.resolution) == pytest.approx(SCALE, rel=0.03)
+    assert scale == pytest.approx(view_scale, rel=0.03)
+    assert (bottom - top) / (map_data.height * map_data.resolution) == pytest.approx(view_scale, rel=0.03)
     x0, y0, _ = map_data.origin
     free = MAP_ALPHA * 254.0 + (1 - MAP_ALPHA) * BACKGROUND
     for index, robot in enumerate(world.robots):

@@ -10,8 +10,9 @@ Every control period (sim time) it
    old data. Lookups and failures are counted and published;
 3. picks its target: its slot from ``/fleet/assignment``, or, when the slot or the straight way
    to it is blocked (a wall, its inflation, something the laser sees), a point on the leader's
-   recent path (the trail) as far behind the leader as the slot is: a path the leader drove is
-   free, and the follower rejoins its slot once the way is clear again;
+   recent path (the trail) ``~trail_lookahead`` ahead of where the follower is on it, but no
+   nearer the leader than the slot is: a path the leader drove is free, also around corners and
+   through doors, and the follower rejoins its slot once the way is clear again;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or closer
@@ -44,6 +45,7 @@ NODE_PARAMS = {
     "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
     "scan_clearance": 0.35,   # a laser point closer than this to the way to the slot blocks it [m]
     "scan_horizon": 2.0,      # how far along the way to the slot the laser check looks [m]
+    "trail_lookahead": 0.6,   # on the trail, drive to the point this far ahead on it [m]
 }
 HOLD_STATES = ("IDLE", "ABORTED")
 
@@ -251,7 +253,8 @@ class FollowerController(object):
             blocked = self._scan_blocks(pose, slot)
         if not blocked or len(self.trail) < 2:
             return slot, "slot"
-        tx, ty = self.trail.point_behind(math.hypot(slot[0], slot[1]))
+        tx, ty = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"],
+                                          math.hypot(slot[0], slot[1]))
         t = relative(ref_map, Pose2D(tx, ty, 0.0))
         return (t.x, t.y), "trail"
 

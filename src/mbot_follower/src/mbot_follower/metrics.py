@@ -32,6 +32,12 @@ What the numbers mean (all times sim time unless marked wall):
                     and gaps longer than stale_after are not travel).
   energy            integral of each robot's power over sim time: every power value holds until
                     the next one, for at most stale_after. [J] if power is in [W].
+  sampling          a sample at t uses every robot's newest pose not later than t (and not older
+                    than stale_after). Each robot's poses come on their own topic, and a busy
+                    machine delivers one stream later than another (at real_time_factor 0 a
+                    tenth of a wall second is seconds of sim time), so the sample at t waits
+                    until every robot's stream has passed t; a stream more than hold_back
+                    behind the newest pose (a removed robot) is not waited for.
   time in state     sim time between the coordinator's state changes, the last one up to the end.
   recovery          per loss (the status shows a new `lost` member at t0): time from t0 to the
                     state DEGRADED (0 if it already was), and the time from t0 until the slot RMS
@@ -80,7 +86,7 @@ class MetricsConfig(object):
     """Parameters of the metrics (the node reads them from its private parameters)."""
 
     def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
-                 robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0):
+                 robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0):
         self.rate = rate                      # samples per sim second [Hz]
         self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
@@ -89,13 +95,14 @@ class MetricsConfig(object):
         self.stale_after = stale_after        # an older pose is not used; power holds at most this long [s]
         self.moving_speed = moving_speed      # a leader faster than this is moving [m/s]
         self.teleport_speed = teleport_speed  # a faster jump between two poses is a teleport, not travel [m/s]
+        self.hold_back = hold_back            # a sample waits this long for a late robot's poses [s]
         self.check()
 
     def check(self):
         """ValueError naming the first bad value (every value must be a finite number)."""
         limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
-                  ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False)]
+                  ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True)]
         for key, low, low_ok in limits:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
@@ -152,6 +159,7 @@ class MetricsCollector(object):
         self.state = ""          # coordinator state, "" before the first status
         self.lost = ()           # robots the status reports lost
         self.poses = {}          # robot -> (t, x, y, theta): the newest ground truth
+        self.history = {}        # robot -> [(t, x, y, theta, distance)] of the last hold_back + stale_after seconds
         self.distance = {}       # robot -> path length so far [m]
         self.energy = {}         # robot -> energy so far [J]
         self.power = {}          # robot -> (t, power [W]) of the newest power message
@@ -172,17 +180,9 @@ class MetricsCollector(object):
     # --- inputs -------------------------------------------------------------------------
 
     def on_pose(self, robot, t, x, y, theta):
-        """A ground-truth pose in map. The first pose later than the next sample time takes that
-        sample first: then every robot's newest pose is at or before the sample time (the
-        simulator publishes the poses of one step before those of the next)."""
+        """A ground-truth pose in map; then every sample whose time all robots' streams have
+        passed (module docstring: sampling)."""
         self._know(robot)
-        ticks = t * self.config.rate   # sample times are whole ticks: k / rate
-        if self._next_tick is None:
-            self._next_tick = int(math.ceil(ticks - 1e-6))
-        elif ticks > self._next_tick + 1e-6:
-            self.run.samples.append(self.sample(self._next_tick / self.config.rate))
-            # After a gap (e.g. a paused simulation) the next sample is the first tick not before t.
-            self._next_tick = max(self._next_tick + 1, int(math.ceil(ticks - 1e-6)))
         previous = self.poses.get(robot)
         if previous is not None and t < previous[0]:
             return   # older than what we have: arrived out of order
@@ -191,6 +191,37 @@ class MetricsCollector(object):
             if step <= self.config.teleport_speed * (t - previous[0]):
                 self.distance[robot] += step
         self.poses[robot] = (t, x, y, theta)
+        history = self.history.setdefault(robot, [])
+        history.append((t, x, y, theta, self.distance[robot]))
+        keep = self.config.hold_back + self.config.stale_after + 1.0
+        if history[0][0] < t - 2.0 * keep:   # trim now and then, not on every pose
+            del history[:next(i for i, h in enumerate(history) if h[0] >= t - keep)]
+        ticks = t * self.config.rate   # sample times are whole ticks: k / rate
+        if self._next_tick is None:
+            self._next_tick = int(math.ceil(ticks - 1e-6))
+        self._take_samples()
+
+    def _take_samples(self):
+        newest = max(p[0] for p in self.poses.values())
+        # After a gap (e.g. a reset) the next sample is the first tick the fleet's poses can fill.
+        first = int(math.ceil((newest - self.config.hold_back - self.config.stale_after) * self.config.rate - 1e-6))
+        self._next_tick = max(self._next_tick, first)
+        while True:
+            t = self._next_tick / self.config.rate
+            if newest <= t + 1e-9:
+                return   # nobody has passed t yet
+            waiting = [p for p in self.poses.values() if p[0] <= t + 1e-9 and newest - p[0] <= self.config.hold_back]
+            if waiting:
+                return   # a late stream may still bring its pose at t
+            self.run.samples.append(self.sample(t))
+            self._next_tick += 1
+
+    def _pose_at(self, robot, t):
+        """(t, x, y, theta, distance so far): the robot's newest pose not later than t, or None."""
+        for entry in reversed(self.history.get(robot, ())):
+            if entry[0] <= t + 1e-9:
+                return entry
+        return None
 
     def on_assignment(self, t, assignment):
         """A new slot assignment (leader, formation, spacing, slots {robot: (x, y)} in the leader frame)."""
@@ -268,7 +299,9 @@ class MetricsCollector(object):
     def sample(self, t):
         """A Sample of the fleet at t from the newest fresh pose of every robot, with the
         assignment and the status in force at t."""
-        fresh = {r: p[1:] for r, p in self.poses.items() if t - p[0] <= self.config.stale_after}
+        at_t = {r: self._pose_at(r, t) for r in self.poses}
+        at_t = {r: p for r, p in at_t.items() if p is not None and t - p[0] <= self.config.stale_after}
+        fresh = {r: p[1:4] for r, p in at_t.items()}
         entry = self._in_force(self._assignments, t)
         a = entry[1] if entry is not None else None
         entry = self._in_force(self._statuses, t)
@@ -292,7 +325,7 @@ class MetricsCollector(object):
             # The plan in force when the leader was where its pose says: under load the 100 Hz
             # ground truth may lag behind the plans, and a plan that starts ahead of an old pose
             # is not the leader's lateral error.
-            entry = self._in_force(self.plans.get(leader, []), self.poses[leader][0])
+            entry = self._in_force(self.plans.get(leader, []), at_t[leader][0])
             if entry is not None and entry[1] is not None:
                 lateral = distance_to_polyline(lx, ly, entry[1])
         clearance, pair = NAN, ""
@@ -305,8 +338,8 @@ class MetricsCollector(object):
         robots = {}
         for r in self.run.robots:
             x, y, theta = fresh.get(r, (NAN, NAN, NAN))
-            robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN),
-                                    self.distance[r], self.energy[r])
+            distance = at_t[r][4] if r in at_t else self.distance[r]
+            robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN), distance, self.energy[r])
         return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)

@@ -1,8 +1,9 @@
 """The leader's recent path, to follow it when a slot falls into a wall.
 
 In a corridor the slots beside the leader are inside the walls; a follower then drives along
-the leader's own track instead, `distance` metres of path behind the leader, which is free
-because the leader just drove there. Points are in the world (map) frame [m]. Pure Python.
+the leader's own track instead, which is free because the leader just drove there: it pursues a
+point a little ahead of where it is on the track (`pursuit_point`), at most as far as `distance`
+metres of path behind the leader. Points are in the world (map) frame [m]. Pure Python.
 """
 import collections
 import math
@@ -71,3 +72,25 @@ class Trail(object):
             left -= step
             k -= 1
         return self._points[0]
+
+    def pursuit_point(self, x, y, lookahead, distance):
+        """(x, y) to drive to for a robot at (x, y) that follows the path: `lookahead` [m] of path
+        beyond the path point nearest to the robot, but no nearer to the newest point than
+        `distance` [m] of path. Driving straight to it stays near the path, around corners and
+        through doors, where the point `distance` behind the newest may lie behind a wall."""
+        if not self._points:
+            raise ValueError("Trail.pursuit_point: the trail is empty (add() the leader's positions first)")
+        for name, value in (("lookahead", lookahead), ("distance", distance)):
+            if isinstance(value, bool) or not math.isfinite(value) or value < 0:
+                raise ValueError("Trail.pursuit_point: %s must be a finite number >= 0 [m], got %r" % (name, value))
+        nearest, at = float("inf"), 0.0     # distance to the path, arc length from the oldest point
+        arc = 0.0
+        for k, step in enumerate(self._steps):
+            (x0, y0), (x1, y1) = self._points[k], self._points[k + 1]
+            u = min(1.0, max(0.0, ((x - x0) * (x1 - x0) + (y - y0) * (y1 - y0)) / (step * step)))
+            d = math.hypot(x0 + u * (x1 - x0) - x, y0 + u * (y1 - y0) - y)
+            if d < nearest:
+                nearest, at = d, arc + u * step
+            arc += step
+        target = max(0.0, min(at + lookahead, self._length - distance))
+        return self.point_behind(self._length - target)

@@ -312,6 +312,35 @@ def test_clearance_contacts_and_stale_poses():
     assert math.isnan(c.run.samples[-1].robots["robot_3"].x)
 
 
+def test_a_sample_waits_for_a_late_stream_and_uses_each_robots_pose_at_its_time():
+    # robot_2's poses arrive 0.5 s (sim) late, as a starved subscriber thread delivers them
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge())
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    late = []
+    for i in range(0, 5 * GT_HZ):
+        t = i / float(GT_HZ)
+        c.on_pose("robot_0", t, 0.5 * t, 0.0, 0.0)
+        c.on_pose("robot_1", t, 0.5 * t - 1.0, 0.5, 0.0)
+        late.append((t, 0.5 * t - 1.0, -0.5))
+        if t >= 0.5:
+            lt, lx, ly = late.pop(0)
+            c.on_pose("robot_2", lt, lx, ly, 0.0)
+    # every sample has every robot, on its slot (robot_2's pose of the sample's time, not its newest)
+    assert len(c.run.samples) >= 40
+    for sample in c.run.samples:
+        assert set(sample.robots) == {"robot_0", "robot_1", "robot_2"}
+        assert sample.slot_max == pytest.approx(0.0, abs=1e-9), sample.t
+    # a stream that stops (a removed robot) holds the samples back hold_back seconds, no longer
+    n = len(c.run.samples)
+    for i in range(5 * GT_HZ, 12 * GT_HZ):
+        t = i / float(GT_HZ)
+        c.on_pose("robot_0", t, 0.5 * t, 0.0, 0.0)
+        c.on_pose("robot_1", t, 0.5 * t - 1.0, 0.5, 0.0)
+    assert c.run.samples[-1].t >= 11.5 and len(c.run.samples) > n
+    assert math.isnan(c.run.samples[-1].robots["robot_2"].x)
+
+
 def test_energy_integral_of_power_and_distance_without_teleports():
     c = MetricsCollector(MetricsConfig(stale_after=1.0))
 
@@ -341,15 +370,18 @@ def test_files_read_back_into_the_same_run_and_summary(tmp_path):
     writer = RunWriter(str(tmp_path / "run"))
     writer.write(c.run, summarize(c.run))
     # More samples and a robot that appears later (new columns): the files grow and stay whole.
+    # robot_1 and robot_2 fall silent at 10 s: the samples wait hold_back (5 s) for them.
     c.on_assignment(10.0, wedge(dict(WEDGE, robot_9=(-2.0, 0.0)), "wedge"))
-    drive(c, 10.0, 11.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
-    c.on_follower_state("robot_9", 11.0, 10.9, True, 3, 0, 0.001, "slot")
+    drive(c, 10.0, 15.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
+    assert len(c.run.samples) == 100
+    drive(c, 15.0, 16.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
+    c.on_follower_state("robot_9", 16.0, 15.9, True, 3, 0, 0.001, "slot")
     live = summarize(c.run)
     writer.write(c.run, live)
 
     back = load_run(str(tmp_path / "run"))
     assert back.robots == c.run.robots == ["robot_0", "robot_1", "robot_2", "robot_9"]
-    assert len(back.samples) == len(c.run.samples) == 110
+    assert len(back.samples) == len(c.run.samples) == 160
     assert "robot_9" not in back.samples[0].robots and "robot_9" in back.samples[-1].robots
     # Compared as text: exact floats, and NaN (no data) reads back as NaN.
     assert [str(s) for s in back.samples] == [str(s) for s in c.run.samples]
@@ -358,7 +390,7 @@ def test_files_read_back_into_the_same_run_and_summary(tmp_path):
     assert summarize(back) == live
     with open(str(tmp_path / "run" / "metrics.json")) as f:
         assert json.load(f) == live
-    assert live["fleet"]["contacts"] == 1 and live["robots"]["robot_9"]["slot_samples"] == 10
+    assert live["fleet"]["contacts"] == 1 and live["robots"]["robot_9"]["slot_samples"] == 60
     assert live["robots"]["robot_9"]["slot_rms_m"] == pytest.approx(0.1)
 
 

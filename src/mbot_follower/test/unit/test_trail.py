@@ -51,3 +51,24 @@ def test_errors_are_named():
         Trail(max_length=float("inf"))
     with pytest.raises(ValueError, match="position must be finite"):
         trail.add(math.nan, 0.0)
+
+
+def test_pursuit_point_leads_along_the_path_from_where_the_robot_is():
+    trail = Trail(min_step=0.05)
+    for x in (0.0, 1.0, 2.0, 3.0, 4.0):          # east along y = 0 ...
+        trail.add(x, 0.0)
+    for y in (1.0, 2.0, 3.0, 4.0):               # ... then north through a "door" at (4, 0)
+        trail.add(4.0, y)
+    # a robot beside the start follows the path 1 m on, not straight to the point near the leader
+    assert trail.pursuit_point(0.5, -0.3, 1.0, 1.0) == pytest.approx((1.5, 0.0))
+    # around the corner: 0.5 m before it, 1 m on is 0.5 m up the northern leg
+    assert trail.pursuit_point(3.5, 0.1, 1.0, 1.0) == pytest.approx((4.0, 0.5))
+    # never nearer the leader than `distance` of path: 1 m behind the newest point (4, 4)
+    assert trail.pursuit_point(4.0, 2.8, 1.0, 1.0) == pytest.approx((4.0, 3.0))
+    assert trail.pursuit_point(4.0, 3.9, 1.0, 1.0) == pytest.approx((4.0, 3.0))
+    # a robot behind the oldest point is led to the path's start first
+    assert trail.pursuit_point(-3.0, 0.0, 1.0, 1.0) == pytest.approx((1.0, 0.0))
+    with pytest.raises(ValueError, match="lookahead"):
+        trail.pursuit_point(0.0, 0.0, float("nan"), 1.0)
+    with pytest.raises(ValueError, match="empty"):
+        Trail().pursuit_point(0.0, 0.0, 1.0, 1.0)

@@ -56,7 +56,7 @@ struct StageParams
   double lockstep_period = 0.05;   ///< ~lockstep_period: distance of the boundaries [s sim time]
   double lockstep_active_timeout = 0.5;  ///< ~lockstep_active_timeout: a robot is driven while its
                                          ///< last cmd_vel is at most this old [s sim time]
-  double lockstep_wall_timeout = 0.5;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
+  double lockstep_wall_timeout = 2.0;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
   double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: each robot's localization
                                            ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
 };
