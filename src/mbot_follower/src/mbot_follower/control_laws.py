@@ -72,7 +72,7 @@ class ControllerConfig(object):
         self.max_angular_accel = 3.0       # [rad/s^2]
         self.max_reverse_vel = 0.1         # diff drive: fastest backing up [m/s]
         self.smoothing = 0.3               # weight of the new command in the filter, (0, 1] [-]
-        self.slot_tolerance = 0.05         # closer than this to a still slot = in the slot [m]
+        self.slot_tolerance = 0.1          # closer than this to a still slot = in the slot: face the leader's way [m]
         self.safety_distance = 0.8         # stop if something is closer than this ahead [m]
         self.safety_half_angle = math.radians(30)  # half-width of "ahead" [rad]
         self.safety_near_distance = 0.45   # stop if something is this close on the side it drives to [m]

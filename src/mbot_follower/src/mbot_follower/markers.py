@@ -52,18 +52,19 @@ def fleet_markers(core, poses, stamp):
             continue
         if robot != a.leader:
             links.points += [Point(leader.x, leader.y, 0.05), Point(pose.x, pose.y, 0.05)]
+        # below the robot: the simulator's markers write its name above it
         label = _marker("labels", i, Marker.TEXT_VIEW_FACING, stamp, TEXT_COLOR)
-        label.pose.position.x, label.pose.position.y, label.pose.position.z = pose.x, pose.y + 0.45, 0.3
-        label.scale.z = 0.3
+        label.pose.position.x, label.pose.position.y, label.pose.position.z = pose.x, pose.y - 0.45, 0.3
+        label.scale.z = 0.25
         if robot == a.leader:
-            label.text = "%s (leader)" % robot
+            label.text = "leader"
         else:
             dist, heading = errors.get(robot, (float("nan"), float("nan")))
-            label.text = "%s %.0f cm %.0f deg" % (robot, dist * 100.0, math.degrees(heading))
+            label.text = "%.0f cm %.0f deg" % (dist * 100.0, math.degrees(heading))
         array.markers.append(label)
     array.markers.append(links)
     state = _marker("state", 0, Marker.TEXT_VIEW_FACING, stamp, PAUSE_COLOR if core.paused else TEXT_COLOR)
-    state.pose.position.x, state.pose.position.y, state.pose.position.z = leader.x, leader.y + 0.9, 0.5
+    state.pose.position.x, state.pose.position.y, state.pose.position.z = leader.x, leader.y + 1.2, 0.5
     state.scale.z = 0.4
     state.text = "%s %s%s" % (core.state(), core.formation, " PAUSED" if core.paused else "")
     array.markers.append(state)

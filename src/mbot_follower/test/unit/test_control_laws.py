@@ -110,7 +110,7 @@ def test_diff_drive_never_backs_up_fast():
     # slot 2 m behind, leader still: u = (-1.6, 0): turn round, backing up at most 0.1 m/s
     inp = ControlInput(Pose2D(0.0, 0.0, 0.0), (-2.0, 0.0), Twist2D(0, 0, 0), [])
     assert tuple(SlotTracking().compute(inp, config)) == pytest.approx((-0.1, 0.0, 2.0 * math.pi))
-    # 3 cm past a still slot: |u| = 0.024 < k_position * slot_tolerance = 0.04, so it keeps
+    # 3 cm past a still slot: |u| = 0.024 < k_position * slot_tolerance = 0.08, so it keeps
     # facing the leader's way and backs up the 3 cm
     inp = ControlInput(Pose2D(-1.97, 0.0, 0.0), (-2.0, 0.0), Twist2D(0, 0, 0), [])
     assert tuple(SlotTracking().compute(inp, config)) == pytest.approx((-0.024, 0.0, 0.0))
