@@ -109,7 +109,7 @@ class GridMap:
 def disk(radius):
     """A boolean disk structuring element of ``radius`` [m]."""
     r = int(round(radius / RESOLUTION))
-    y, x = np.ogrid[-r : r + 1, -r : r + 1]
+    y, x = np.ogrid[-r:r + 1, -r:r + 1]
     return x * x + y * y <= r * r
 
 

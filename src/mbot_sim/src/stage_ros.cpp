@@ -83,6 +83,9 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   pnh.param("lockstep_wall_timeout", p.lockstep_wall_timeout, 2.0);
   if (!(p.lockstep_wall_timeout > 0.0))
     throw StartupError(pnh.resolveName("lockstep_wall_timeout") + ": expected a number > 0 [s]");
+  pnh.param("lockstep_pacer_lag", p.lockstep_pacer_lag, 0.3);
+  if (!(p.lockstep_pacer_lag > 0.0))
+    throw StartupError(pnh.resolveName("lockstep_pacer_lag") + ": expected a number > 0 [s]");
   pnh.param("lockstep_localization_lag", p.lockstep_localization_lag, 0.1);
   if (!(p.lockstep_localization_lag >= 0.0))
     throw StartupError(pnh.resolveName("lockstep_localization_lag") + ": expected a number >= 0 [s]");
@@ -139,7 +142,11 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   services_.push_back(nh_.advertiseService("set_fault", &StageRos::onSetFault, this));
   world_->setListener(this);
   if (params_.lockstep)  // only then: every /tf message costs this node a callback
+  {
     tf_sub_ = nh_.subscribe("/tf", 1000, &StageRos::onTf, this, ros::TransportHints().tcpNoDelay());
+    heartbeat_sub_ = nh_.subscribe("/lockstep/heartbeat", 100, &StageRos::onHeartbeat, this,
+                                   ros::TransportHints().tcpNoDelay());
+  }
 
   ROS_INFO("stage_node: world %s: %zu robots, %zu obstacles, map walls as %zu boxes, physics step %.3f s, "
            "real-time factor %g%s, seed %u",
@@ -321,6 +328,10 @@ void StageRos::noteBoundary()
 /// time runs away from a localization that cannot keep up (between goals, when no robot is driven,
 /// or when a controller answers at once with a stop, as move_base does without a fresh pose) and
 /// the robot never gets a fresh pose again.
+/// Nodes that must keep pace with sim time without driving a robot (the fleet coordinator, whose
+/// loss detection counts sim seconds) send a heartbeat (std_msgs/Header: frame_id their name,
+/// stamp their sim time) on /lockstep/heartbeat every cycle; each is waited for until its newest
+/// heartbeat is at most ~lockstep_pacer_lag behind sim time.
 /// After ~lockstep_wall_timeout the robots whose controller did not answer count as not driven
 /// until their next cmd_vel, and a localization still behind is not waited for until it has caught
 /// up by itself, so a dead controller or localization costs one timeout, not one per boundary.
@@ -340,12 +351,17 @@ bool StageRos::waitForControllers()
            localizationCurrent(io);
   };
   const auto waitingFor = [&](const RobotIo& io) { return (driven(io) && !answered(io)) || !localized(io); };
+  const auto paced = [this](const Pacer& p) {
+    return p.ignored || p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9;
+  };
   while (true)
   {
     if (!ros::ok() || paused_) return false;
     bool all_answered = true;
     for (const auto& io : io_)
       if (io && waitingFor(*io)) all_answered = false;
+    for (const auto& p : pacers_)
+      if (!paced(p.second)) all_answered = false;
     if (all_answered) break;
     if (ros::WallTime::now() >= deadline)
     {
@@ -364,6 +380,13 @@ bool StageRos::waitForControllers()
                     std::to_string(world_->time() - io->localization_stamp) + " s behind)";
             io->localization_ignored = true;
           }
+        }
+      for (auto& p : pacers_)
+        if (!paced(p.second))
+        {
+          late += (late.empty() ? "" : ", ") + p.first + " (heartbeat " +
+                  std::to_string(world_->time() - p.second.stamp) + " s behind)";
+          p.second.ignored = true;
         }
       ++lockstep_timeouts_;
       const ros::WallTime wall_now = ros::WallTime::now();
@@ -522,6 +545,15 @@ void StageRos::onTf(const tf2_msgs::TFMessage::ConstPtr& msg)
     io.localization_stamp = std::max(io.localization_stamp, t.header.stamp.toSec());
     if (io.localization_ignored && localizationCurrent(io)) io.localization_ignored = false;  // caught up
   }
+}
+
+/// Lockstep: the newest heartbeat of a node that paces sim time (see waitForControllers()).
+void StageRos::onHeartbeat(const std_msgs::Header::ConstPtr& msg)
+{
+  if (msg->frame_id.empty()) return;
+  Pacer& p = pacers_[msg->frame_id];
+  p.stamp = std::max(p.stamp, msg->stamp.toSec());
+  if (p.ignored && p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9) p.ignored = false;  // caught up
 }
 
 void StageRos::onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg)

@@ -184,7 +184,8 @@ def parse_count(text):
     except ValueError:
         count = None
     if count is None or not 1 <= count <= 20:
-        raise ConfigError("robots: expected a number of robots from 1 to 20 (or nothing: the world's), got \"%s\"" % text)
+        raise ConfigError("robots: expected a number of robots from 1 to 20 (or nothing: the world's), "
+                          "got \"%s\"" % text)
     return count
 
 
@@ -195,7 +196,8 @@ def main(argv=None):
     parser.add_argument("--world", help="world name (maps/NAME.world.yaml) or path")
     parser.add_argument("--robots", default="", help="number of robots (empty: the world's)")
     parser.add_argument("--out", help="the run's world file to write")
-    parser.add_argument("--mode", default="formation", help="fleet.launch's mode, checked here: %s" % " or ".join(MODES))
+    parser.add_argument("--mode", default="formation",
+                        help="fleet.launch's mode, checked here: %s" % " or ".join(MODES))
     parser.add_argument("--spacing", type=float, default=PlacementConfig().spacing, help="[m] between added robots")
     parser.add_argument("--names", metavar="WORLD_FILE", help="print the robots of a world file as a YAML list")
     args = parser.parse_args([a for a in (sys.argv[1:] if argv is None else argv) if ":=" not in a])

@@ -88,7 +88,7 @@ class Recording(object):
     def summary_lines(self):
         """Human-readable lines: one per robot, then the contacts."""
         lines = ["%-10s %8s %8s %8s %9s %9s %8s" % ("robot", "odom Hz", "scan Hz", "gt Hz",
-                                                     "moved m", "nearest m", "final x,y")]
+                                                    "moved m", "nearest m", "final x,y")]
         for name in sorted(self.robots):
             tr = self.robots[name]
             final = "%.2f,%.2f" % (tr.x[-1], tr.y[-1]) if tr.x else "-"

@@ -222,7 +222,8 @@ def _read_obstacle(r):
 def _read_fault(r):
     r.check_keys(["robot"] + FAULT_KEYS, required=["robot"])
     robot = _name_arg(r, "robot", "a robot name")
-    faults = Faults(*[r.optional(k, float, 0.0) for k in FAULT_KEYS[:4]] + [r.optional(k, bool, False) for k in FAULT_KEYS[4:]])
+    faults = Faults(*[r.optional(k, float, 0.0) for k in FAULT_KEYS[:4]]
+                    + [r.optional(k, bool, False) for k in FAULT_KEYS[4:]])
     problem = check_faults(faults)
     if problem:
         field, _, rest = problem.partition(": ")
@@ -313,7 +314,8 @@ def _read_criteria(r, mode, scenario):
                         % (name, ", ".join(defaults)))
             del criteria[name]
             continue
-        what = "true or false" if kind is bool else "%s (%s %s)" % ("an integer" if kind is int else "a number", op, what)
+        number = "an integer" if kind is int else "a number"
+        what = "true or false" if kind is bool else "%s (%s %s)" % (number, op, what)
         criteria[name] = cr.required(name, kind, what=what)
     return criteria
 
@@ -341,8 +343,10 @@ def load_scenario(path):
         s.formation = r.required("formation", str, what="one of %s" % ", ".join(FORMATION_NAMES),
                                  check=lambda v: v in FORMATION_NAMES)
         s.spacing = r.required("spacing", float, what="a number > 0 [m]", check=lambda v: v > 0.0)
-        s.topology = r.optional("topology", str, "star", what=" or ".join(TOPOLOGIES), check=lambda v: v in TOPOLOGIES)
-        s.controller = r.optional("controller", str, "slot_tracking", what="one of %s" % ", ".join(sorted(CONTROL_LAWS)),
+        s.topology = r.optional("topology", str, "star", what=" or ".join(TOPOLOGIES),
+                                check=lambda v: v in TOPOLOGIES)
+        s.controller = r.optional("controller", str, "slot_tracking",
+                                  what="one of %s" % ", ".join(sorted(CONTROL_LAWS)),
                                   check=lambda v: v in CONTROL_LAWS)
         s.leader_max_vel = r.optional("leader_max_vel", float, 0.35, what="a number > 0 [m/s]", check=lambda v: v > 0.0)
     else:
@@ -603,8 +607,8 @@ def summary_lines(name, results):
     """The one-screen summary: a line per criterion, PASS or FAIL, and the verdict."""
     lines = ["scenario %s:" % name]
     for c in results:
-        lines.append("  %s  %-30s %10s %s %s" % ("PASS" if c["passed"] else "FAIL", c["name"], format_value(c["value"]),
-                                              c["op"], format_value(c["threshold"])))
+        lines.append("  %s  %-30s %10s %s %s" % ("PASS" if c["passed"] else "FAIL", c["name"],
+                                                 format_value(c["value"]), c["op"], format_value(c["threshold"])))
     failed = [c["name"] for c in results if not c["passed"]]
     lines.append("PASSED (%d criteria)" % len(results) if not failed else
                  "FAILED: %s" % ", ".join(failed))

@@ -65,7 +65,8 @@ def scenario_path(name_or_path):
         return os.path.abspath(name_or_path)
     path = os.path.join(scenarios_directory(), name_or_path + ".yaml")
     if not os.path.isfile(path):
-        raise ConfigError('scenario "%s": no file %s (scenarios: %s)' % (name_or_path, path, ", ".join(list_scenarios())))
+        raise ConfigError('scenario "%s": no file %s (scenarios: %s)'
+                          % (name_or_path, path, ", ".join(list_scenarios())))
     return path
 
 
@@ -641,7 +642,8 @@ def run(args):
     os.environ.update(ROS_MASTER_URI=env["ROS_MASTER_URI"], ROS_LOG_DIR=env["ROS_LOG_DIR"])
     launch_args = [("world", world_argument(scenario)), ("robots", "" if scenario.robots is None else scenario.robots),
                    ("mode", scenario.mode), ("localization", scenario.localization),
-                   ("real_time_factor", 1 if args.real_time else 0), ("lockstep", "false" if args.real_time else "true"),
+                   ("real_time_factor", 1 if args.real_time else 0),
+                   ("lockstep", "false" if args.real_time else "true"),
                    ("rviz", "true" if rviz else "false"), ("record", "false" if args.no_record else "true"),
                    ("run_dir", run_dir)]
     if scenario.mode == "formation":
@@ -708,8 +710,8 @@ def run(args):
               "final state %s" % (facts["end_s"], len(player.log), facts["failed_steps"], facts["arrivals"],
                                   facts["targets"], facts["goals_reached"], facts["final_state"] or "-"))
     shots = screenshots.taken if screenshots is not None else []
-    print("run dir: %s (%s%d screenshots)" % (run_dir, "run.bag, " if os.path.exists(os.path.join(run_dir, "run.bag"))
-                                             else "", len(shots)))
+    bag = "run.bag, " if os.path.exists(os.path.join(run_dir, "run.bag")) else ""
+    print("run dir: %s (%s%d screenshots)" % (run_dir, bag, len(shots)))
     return 0 if all(c["passed"] for c in results) else 1
 
 

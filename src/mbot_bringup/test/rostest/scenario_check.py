@@ -33,7 +33,8 @@ def wait_for_metrics(metrics_dir, until, wall_timeout=60.0):
         except RunFileError:
             pass
         time.sleep(0.5)
-    raise AssertionError("%s: the metrics do not reach %.1f s sim after %.0f s wall" % (metrics_dir, until, wall_timeout))
+    raise AssertionError("%s: the metrics do not reach %.1f s sim after %.0f s wall"
+                         % (metrics_dir, until, wall_timeout))
 
 
 class ScenarioCheck(unittest.TestCase):
@@ -65,7 +66,8 @@ class ScenarioCheck(unittest.TestCase):
             launched = {k: rospy.get_param("/coordinator/" + k) for k in ("formation", "spacing", "topology", "leader")}
             expected = {"formation": scenario.formation, "spacing": scenario.spacing, "topology": scenario.topology,
                         "leader": scenario.leader}
-            self.assertEqual(launched, expected, "the .test file's fleet.launch arguments differ from %s" % scenario.path)
+            self.assertEqual(launched, expected,
+                             "the .test file's fleet.launch arguments differ from %s" % scenario.path)
         else:
             self.assertTrue(rospy.has_param("/dispatcher/world"), "the .test file must launch mode:=dispatch")
 

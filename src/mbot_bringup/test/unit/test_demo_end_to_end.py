@@ -13,7 +13,8 @@ RUN_DIR = os.path.join(ROOT, "out", "demo")
 
 def test_demo_triangle_trio_passes_and_leaves_a_complete_run_dir():
     # a plain shell: no ROS environment of the caller, whatever python3 comes first on PATH
-    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS") and k not in ("PYTHONPATH", "CMAKE_PREFIX_PATH")}
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith("ROS") and k not in ("PYTHONPATH", "CMAKE_PREFIX_PATH")}
     result = subprocess.run([os.path.join(ROOT, "scripts", "demo"), "triangle_trio", "--no-rviz"], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=900)
     output = result.stdout[-4000:]

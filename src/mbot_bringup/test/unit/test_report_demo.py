@@ -15,7 +15,7 @@ def make_world(tmp_path):
     with open(str(tmp_path / "m.pgm"), "wb") as f:
         f.write(b"P5\n# test map\n60 40\n255\n" + img.tobytes())
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.1\norigin: [-1.0, -2.0, 0.0]\n"
-                                      "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
+                                     "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
     (tmp_path / "w.world.yaml").write_text("map: m.yaml\nrobots: []\n")
     return str(tmp_path / "w.world.yaml")
 

@@ -1,6 +1,6 @@
 """scripts/screenshot (the fleet view fleet_rviz writes for trio, under Xvfb, captured by
-mbot_bringup.screenshot) of a running trio world: the PNG is not blank, and each robot's marker colour appears where the robot
-stands.
+mbot_bringup.screenshot) of a running trio world: the PNG is not blank, and each robot's marker
+colour appears where the robot stands.
 
 Starts its own ROS master on a free port, the simulator (mbot_sim sim.launch world:=trio) and the
 map server (empty map), and stops them by PID at the end. Skips when ROS, Xvfb, rviz or

@@ -89,7 +89,8 @@ def test_fleet_view_is_centred_on_the_map_and_fits_it(tmp_path):
     m = world.map_data
     x0, y0 = m.origin[0], m.origin[1]
     x1, y1 = x0 + m.width * m.resolution, y0 + m.height * m.resolution
-    view = yaml.safe_load(open(write_fleet_view("office", str(tmp_path / "o.rviz"))))["Visualization Manager"]["Views"]["Current"]
+    with open(write_fleet_view("office", str(tmp_path / "o.rviz"))) as f:
+        view = yaml.safe_load(f)["Visualization Manager"]["Views"]["Current"]
     assert view["X"] == pytest.approx(0.5 * (x0 + x1), abs=0.01)
     assert view["Y"] == pytest.approx(0.5 * (y0 + y1), abs=0.01)
     window = load("fleet")["Window Geometry"]

@@ -32,8 +32,8 @@ def expected_message(path):
 def test_every_key_and_action_is_read():
     s = load_scenario(fixture("valid_every_action.yaml"))
     assert (s.name, s.world, s.robots, s.mode, s.leader) == ("valid_every_action", "trio", 4, "formation", "leader")
-    assert (s.formation, s.spacing, s.topology, s.controller, s.localization) == ("triangle", 1.5, "chain",
-                                                                                 "consensus", "pf")
+    assert (s.formation, s.spacing, s.topology, s.controller, s.localization) == \
+        ("triangle", 1.5, "chain", "consensus", "pf")
     assert (s.leader_max_vel, s.time_limit, s.end) == (0.3, 200.0, "formed")
     assert [st.action for st in s.timeline] == [
         "target", "formation", "formation", "spawn_obstacle", "spawn_obstacle", "remove_obstacle", "set_param",

@@ -89,7 +89,8 @@ class _PgmHeader(object):
             else:
                 break
         start = self.pos
-        while self.pos < len(data) and not data[self.pos:self.pos + 1].isspace() and data[self.pos:self.pos + 1] != b"#":
+        while self.pos < len(data) and not data[self.pos:self.pos + 1].isspace() \
+                and data[self.pos:self.pos + 1] != b"#":
             self.pos += 1
         return data[start:self.pos].decode("latin-1")
 
@@ -138,7 +139,8 @@ def read_pgm(path, yaml_path=None):
             raise ConfigError("%s: truncated PGM: expected %d pixel values, got %d" % (path, count, len(tokens)))
         for k, t in enumerate(tokens):
             if not t.isdigit() or len(t) > 6:
-                raise ConfigError('%s: bad PGM pixel %d: expected an integer, got "%s"' % (path, k, t.decode("latin-1")))
+                raise ConfigError('%s: bad PGM pixel %d: expected an integer, got "%s"'
+                                  % (path, k, t.decode("latin-1")))
         values = np.array([int(t) for t in tokens], dtype=np.int64)
     values = np.minimum(values, maxval)
     if maxval != 255:

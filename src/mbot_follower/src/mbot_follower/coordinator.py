@@ -13,13 +13,12 @@ States (``FleetStatus``)::
     takes over the leader's navigation goal.
 
 While NAVIGATING, the leader waits (its goal is cancelled and sent again) whenever a follower is
-more than ``regroup_error`` behind or beside its slot, until all are within ``resume_error``:
-after a sharp turn, or a formation switch on the move, the slots move faster than a follower can
-drive, and a fleet that drives on while its shape is broken is not a formation. A follower ahead
-of its slot (one that drops back into a column) is judged by its sideways error only: the leader
-driving on brings it closer, waiting would make it turn around. Followers that follow the
-leader's trail past a wall, or that their safety layer holds (something in their way, e.g. a lost
-robot standing still), are excused: the leader's waiting would not bring them closer.
+more than ``regroup_error`` off its slot, until all are within ``resume_error``: after a sharp
+turn, or a formation switch on the move, the slots move faster than a follower can drive, and a
+fleet that drives on while its shape is broken is not a formation (a column must stand before a
+corridor). Followers that follow the leader's trail past a wall, or that their safety layer holds
+(something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
+would not bring them closer.
 
 A goal that cannot be reached as given (a NaN, off the map, in a wall) or an unknown formation
 is refused at once: the state does not change and the message says why.
@@ -227,7 +226,8 @@ class FleetCoordinator(object):
             self.events.append((now, "pause", self.reason))
             return [("cancel", self.leader)]
         if leader_nav is not None and leader_nav.startswith("ABORTED"):
-            self._set_phase(ABORTED, now, "the leader's navigation gave up: %s" % leader_nav[len("ABORTED"):].lstrip(": "))
+            why = leader_nav[len("ABORTED"):].lstrip(": ")
+            self._set_phase(ABORTED, now, "the leader's navigation gave up: %s" % why)
             return actions
         if self._leader_done_at is None and leader_nav != "SUCCEEDED":
             regroup = self._regroup(now, poses, excused)
@@ -247,7 +247,7 @@ class FleetCoordinator(object):
         """The leader waits while a follower is far off its slot (after a sharp turn, or when a
         follower was held up) and drives on once all are close again. None: nothing to do;
         else the actions (possibly none) of waiting."""
-        errors = {r: e for r, e in self.catch_up_errors(poses).items() if r not in excused}
+        errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
         if self._regroup_since is None:
             if worst is None or worst[1] <= self.config.regroup_error or now < self._no_regroup_before:
@@ -307,8 +307,8 @@ class FleetCoordinator(object):
             for name in (self.requested_formation,) + FALLBACK_FORMATIONS:
                 if self._formation_problem(name, self.spacing) is None:
                     if name != self.requested_formation:
-                        words.append("%s does not fit %d robots: %s" % (self.requested_formation,
-                                                                      len(self.members), name))
+                        words.append("%s does not fit %d robots: %s"
+                                     % (self.requested_formation, len(self.members), name))
                     self.formation = name
                     break
         self.reason = "; ".join(words)
@@ -395,24 +395,6 @@ class FleetCoordinator(object):
                 continue
             x, y = _apply(leader, offset)
             result[r] = (math.hypot(poses[r].x - x, poses[r].y - y), normalize_angle(poses[r].theta - leader.theta))
-        return result
-
-    def catch_up_errors(self, poses):
-        """{follower: the part of its slot error that the leader's waiting would cure [m]}: the
-        distance to its slot, less the part of it ahead of the slot along the leader's heading."""
-        a = self.assignment
-        if a is None or a.leader not in poses:
-            return {}
-        leader = poses[a.leader]
-        c, s = math.cos(leader.theta), math.sin(leader.theta)
-        result = {}
-        for r, offset in sorted(a.slots.items()):
-            if r == a.leader or r not in poses:
-                continue
-            x, y = _apply(leader, offset)
-            dx, dy = x - poses[r].x, y - poses[r].y        # from the follower to its slot
-            forward, sideways = c * dx + s * dy, -s * dx + c * dy
-            result[r] = math.hypot(max(forward, 0.0), sideways)
         return result
 
     def _worst_follower(self, poses):

@@ -59,7 +59,7 @@ class CoordinatorNode(object):
         from mbot_msgs.msg import FleetAssignment, FleetGoalAction, FleetStatus, FollowerState
         from mbot_msgs.srv import SetFormation
         from nav_msgs.msg import OccupancyGrid
-        from std_msgs.msg import String
+        from std_msgs.msg import Header, String
         from visualization_msgs.msg import MarkerArray
 
         self._FleetStatus = FleetStatus
@@ -97,6 +97,10 @@ class CoordinatorNode(object):
         self.status_pub = rospy.Publisher("/fleet/status", FleetStatus, queue_size=10)
         self.assignment_pub = rospy.Publisher("/fleet/assignment", FleetAssignment, queue_size=1, latch=True)
         self.marker_pub = rospy.Publisher("/fleet/markers", MarkerArray, queue_size=1)
+        # In lockstep the simulator holds sim time until this heartbeat is current: a loss is
+        # judged in sim seconds, which must not run away while a busy machine starves this node.
+        self.heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10)
+        self._heartbeat = Header(frame_id=rospy.get_name())
         for topic in ("/fleet/target_pose", "/simulation/target_pose"):
             rospy.Subscriber(topic, Pose2DMsg, self._on_target_pose, queue_size=1)
         rospy.Subscriber("/fleet/formation", String, self._on_formation, queue_size=1)
@@ -225,6 +229,7 @@ class CoordinatorNode(object):
     # --- the cycle ----------------------------------------------------------------------------
 
     def _cycle(self, event):
+        started = rospy.Time.now()
         # rospy's timer thread dies with the first exception: a bug must cost one cycle, not the fleet
         try:
             self._step(event)
@@ -232,6 +237,8 @@ class CoordinatorNode(object):
             import traceback
 
             rospy.logerr_throttle(5.0, "coordinator: cycle failed:\n%s" % traceback.format_exc())
+        self._heartbeat.stamp = started
+        self.heartbeat_pub.publish(self._heartbeat)
 
     def _step(self, _event):
         now_ros = rospy.Time.now()

@@ -136,7 +136,8 @@ class FleetProbe(object):
         end = time.time() + wall_timeout
         while time.time() < end and not rospy.is_shutdown():
             with self.lock:
-                ready = self.status is not None and len(self.truth) == len(self.robots) and len(heard) == len(self.robots)
+                everyone = len(self.truth) == len(self.robots) and len(heard) == len(self.robots)
+                ready = self.status is not None and everyone
             if ready:
                 break
             time.sleep(0.1)

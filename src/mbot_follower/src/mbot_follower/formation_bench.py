@@ -137,8 +137,8 @@ def drive(n, seed, log):
     result["converge_s"] = round(t_nav - t0, 2)
     probe.wait(lambda: probe.truth["robot_0"][1].x > -2.0, 300.0, "the leader at x = -2")
     result["rms_straight_m"] = moving_rms(t_nav + 3.0, rospy.get_time())
-    log("n=%d seed=%d: converged in %.1f s, straight RMS %.3f m" % (n, seed, result["converge_s"],
-                                                                      result["rms_straight_m"] or -1))
+    log("n=%d seed=%d: converged in %.1f s, straight RMS %.3f m"
+        % (n, seed, result["converge_s"], result["rms_straight_m"] or -1))
     # 3: switch to a column on the move
     t_switch = rospy.get_time()
     probe.formation_pub.publish(String("column"))
@@ -259,9 +259,9 @@ def main(argv=None):
         for seed in range(args.first_seed, args.first_seed + args.seeds):
             out = subprocess.run([sys.executable, "-m", "mbot_follower.formation_bench", "--one", str(n), str(seed),
                                   "--out", args.out], stdout=subprocess.PIPE, universal_newlines=True)
-            lines = [l for l in out.stdout.splitlines() if l.startswith("{")]
-            run = json.loads(lines[-1]) if lines else {"n": n, "seed": seed, "succeeded": False,
-                                                        "error": "the run printed nothing (exit %d)" % out.returncode}
+            lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+            run = json.loads(lines[-1]) if lines else {
+                "n": n, "seed": seed, "succeeded": False, "error": "the run printed nothing (exit %d)" % out.returncode}
             log("n=%d seed=%d: %s" % (n, seed, json.dumps(run)))
             runs.append(run)
         table[str(n)] = worst(runs)

@@ -112,8 +112,9 @@ def _triangle(n):
         places = _centre_out([j - row / 2.0 for j in range(row + 1)])   # row + 1 places, 1 apart
         count = min(row + 1, n - len(slots))
         if count % 2 == 0 and len(places) % 2 == 1:
-            places = places[1:]      # an even count in a row with a middle place: leave the
-                                     # middle empty, so the row stays symmetric
+            # an even count in a row with a middle place: leave the middle empty, so the row
+            # stays symmetric
+            places = places[1:]
         # (an odd count in a row without a middle place cannot be symmetric: left gets one more)
         slots.extend((-row * row_gap, y) for y in places[:count])
         row += 1

@@ -117,8 +117,8 @@ class MetricsConfig(object):
     def from_dict(cls, values, where="metrics config"):
         unknown = sorted(set(values) - set(vars(cls())))
         if unknown:
-            raise ValueError("%s: unknown key(s) %s (known: %s)" % (where, ", ".join(unknown),
-                                                                   ", ".join(sorted(vars(cls())))))
+            raise ValueError("%s: unknown key(s) %s (known: %s)"
+                             % (where, ", ".join(unknown), ", ".join(sorted(vars(cls())))))
         return cls(**values)
 
 
@@ -339,7 +339,8 @@ class MetricsCollector(object):
         for r in self.run.robots:
             x, y, theta = fresh.get(r, (NAN, NAN, NAN))
             distance = at_t[r][4] if r in at_t else self.distance[r]
-            robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN), distance, self.energy[r])
+            robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN), distance,
+                                    self.energy[r])
         return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)

@@ -7,12 +7,15 @@ robot that appears in an assignment (subscribed when it first appears).
 
 Outputs: ``/fleet/metrics`` (mbot_msgs/FleetMetrics, every ``~publish_period``, 1 s) and, when
 ``~output_dir`` is not empty, metrics.csv, events.csv, controller.csv and metrics.json in it,
-every ``~write_period`` (5 s) and at shutdown, so that a killed run still leaves its files.
+every ``~write_period`` (5 s) and at shutdown, so that a killed run still leaves its files; and
+``/lockstep/heartbeat`` (std_msgs/Header, stamp the newest sample's time), which the simulator
+waits for in lockstep, so that its sim time does not run ahead of what was measured.
 
 Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~physics_step`` 0.01 s added to every
 latency (the simulator applies a command at its next step), ``~recovered_rms`` 0.15 m and
 ``~recovered_hold`` 1 s (recovery after a loss), ``~robot_radius`` 0.15 m (clearance),
-``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s (see MetricsConfig).
+``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s, ``~hold_back`` 5 s (see
+MetricsConfig).
 A message without a stamp (zero) counts at the time it arrives.
 """
 import math
@@ -21,7 +24,7 @@ import threading
 import rospy
 from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
 from nav_msgs.msg import Odometry, Path
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, Header
 
 from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
@@ -70,6 +73,11 @@ class MetricsNode(object):
         self.closed = False
         self.subs = {}
         self.pub = rospy.Publisher("/fleet/metrics", FleetMetrics, queue_size=1)
+        # In lockstep the simulator holds sim time until this heartbeat (the newest sample's time)
+        # is current: on a busy machine the ground-truth streams would otherwise run seconds of
+        # sim time ahead of what this node has measured.
+        self.heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10)
+        self.heartbeat = Header(frame_id=rospy.get_name())
         self.shared_subs = [
             rospy.Subscriber("/fleet/assignment", FleetAssignment, self.on_assignment, queue_size=10),
             rospy.Subscriber("/fleet/status", FleetStatus, self.on_status, queue_size=10),
@@ -122,11 +130,18 @@ class MetricsNode(object):
         try:
             theta = yaw_of(p.orientation)
         except ValueError as error:
-            rospy.logerr_throttle(10.0, "%s: /%s/base_pose_ground_truth: %s; ignored" % (rospy.get_name(), robot, error))
+            rospy.logerr_throttle(10.0, "%s: /%s/base_pose_ground_truth: %s; ignored"
+                                  % (rospy.get_name(), robot, error))
             return
         with self.lock:
-            if not self.closed:
-                self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta)
+            if self.closed:
+                return
+            samples = len(self.collector.run.samples)
+            self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta)
+            if len(self.collector.run.samples) == samples:
+                return
+            self.heartbeat.stamp = rospy.Time.from_sec(self.collector.run.samples[-1].t)
+            self.heartbeat_pub.publish(self.heartbeat)
 
     def on_state(self, msg, robot):
         with self.lock:

@@ -28,6 +28,7 @@ from std_msgs.msg import String
 
 from mbot_follower.fleet_probe import FleetProbe
 
+
 def robots_param():
     return rospy.get_param("~robots")
 
@@ -264,8 +265,8 @@ class FormationChecks(unittest.TestCase):
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED without follower_2")
         self.assertEqual(p.state(), "ARRIVED", p.status.reason)
         # follower_2 comes back near the fleet and takes a slot again, without restarting anyone
-        answer = rospy.ServiceProxy("/spawn_robot", SpawnRobot)(name="follower_2", model="mbot",
-                                                                  pose=Pose2DMsg(1.0, -3.0, 0.0))
+        spawn = rospy.ServiceProxy("/spawn_robot", SpawnRobot)
+        answer = spawn(name="follower_2", model="mbot", pose=Pose2DMsg(1.0, -3.0, 0.0))
         self.assertTrue(answer.success, answer.message)
         t_back = rospy.get_time()
         p.wait(lambda: "follower_2" not in p.status.lost and "follower_2" in [s.robot for s in p.assignment.slots],

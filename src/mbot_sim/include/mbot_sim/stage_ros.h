@@ -21,6 +21,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/LaserScan.h>
+#include <std_msgs/Header.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -59,6 +60,8 @@ struct StageParams
   double lockstep_wall_timeout = 2.0;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
   double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: each robot's localization
                                            ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
+  double lockstep_pacer_lag = 0.3;  ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
+                                    ///< /lockstep/heartbeat) may lag it this much [s sim]
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
@@ -114,6 +117,7 @@ private:
 
   void onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg);
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg);
+  void onHeartbeat(const std_msgs::Header::ConstPtr& msg);
   bool localizationCurrent(const RobotIo& io) const;
   void onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg);
   bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
@@ -138,6 +142,7 @@ private:
   std::vector<std::unique_ptr<RobotIo>> io_;  ///< by robot id; nullptr for removed robots
   ros::Publisher clock_pub_, contact_pub_, marker_pub_;
   ros::Subscriber tf_sub_;  ///< lockstep only: the robots' localization transforms
+  ros::Subscriber heartbeat_sub_;  ///< lockstep only: nodes that pace sim time (the fleet coordinator)
   std::vector<ros::ServiceServer> services_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
@@ -148,6 +153,14 @@ private:
   long boundary_count_ = 0;           ///< boundaries published so far
   double next_boundary_ = 0.0;        ///< sim time of the next boundary [s]
   bool boundary_wait_pending_ = false;  ///< a boundary was published and not yet waited at
+  /// A node that sim time waits for besides the controllers: its newest heartbeat stamp [s sim],
+  /// and whether it timed out (not waited for until it has caught up by itself).
+  struct Pacer
+  {
+    double stamp = -1e9;
+    bool ignored = false;
+  };
+  std::map<std::string, Pacer> pacers_;  ///< by node name (the heartbeat's frame_id)
   long lockstep_timeouts_ = 0;        ///< wall timeouts since the last warning
   ros::WallTime last_lockstep_warning_;
 };
