@@ -19,7 +19,7 @@ target_link_libraries(mbot_nav_core mbot_global_planner mbot_local_planner mbot_
 add_library(mbot_nav_ros src/costmap_ros.cpp src/nav_node.cpp)
 target_compile_options(mbot_nav_ros PRIVATE -Wall -Wextra)
 target_include_directories(mbot_nav_ros PRIVATE ${mbot_description_INCLUDE_DIRS} ${roslib_INCLUDE_DIRS})
-target_link_libraries(mbot_nav_ros mbot_nav_core mbot_localization_ros mbot_localization
+target_link_libraries(mbot_nav_ros mbot_nav_core
   ${mbot_description_LIBRARIES} ${roslib_LIBRARIES} ${catkin_LIBRARIES})
 add_dependencies(mbot_nav_ros ${catkin_EXPORTED_TARGETS})
 add_executable(nav_node src/nav_node_main.cpp)

@@ -7,11 +7,11 @@
 #include <tf2/exceptions.h>
 #include <tf2/utils.h>
 
-#include "mbot_navigation/localization_ros.h"
+#include <mbot_common/ros_edge.h>
 
 namespace mbot_navigation
 {
-using localization::StrictParams;
+using mbot_common::StrictParams;
 
 CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& d)
 {

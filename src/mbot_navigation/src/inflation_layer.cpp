@@ -1,6 +1,6 @@
 #include "mbot_navigation/inflation_layer.h"
 
-#include "mbot_navigation/distance_transform.h"
+#include <mbot_common/distance_transform.h>
 
 #include <algorithm>
 #include <cmath>
@@ -121,7 +121,7 @@ void InflationLayer::updateCosts(Costmap2D& master, const CellWindow& w)
     }
     if (!any) continue;  // no lethal cell within R rows: nothing to inflate in this row
 
-    squaredDistanceTransform1d(row_f_.data(), W, d2_.data(), env_v_.data(), env_z_.data());
+    mbot_common::squaredDistanceTransform1d(row_f_.data(), W, d2_.data(), env_v_.data(), env_z_.data());
 
     uint8_t* row = out_costs + master.index(0, y);
     for (int x = w.x0; x < w.xn; ++x)

@@ -21,7 +21,7 @@
 #include <mbot_common/map_io.h>
 #include <mbot_common/paths.h>
 
-#include "mbot_navigation/localization_ros.h"
+#include <mbot_common/ros_edge.h>
 
 namespace mbot_navigation
 {
@@ -53,7 +53,7 @@ class MapServerNode
 public:
   MapServerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& argument)
   {
-    localization::StrictParams params(pnh);
+    mbot_common::StrictParams params(pnh);
     const std::string param_map = params.getString("map", "");
     const std::string frame_id = params.getString("frame_id", "map");
     params.checkNoUnknown();

@@ -11,12 +11,12 @@
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
 #include "mbot_description/robot_model.h"
-#include "mbot_navigation/localization_ros.h"
+#include <mbot_common/ros_edge.h>
 #include "mbot_navigation/planner_factory.h"
 
 namespace mbot_navigation
 {
-using localization::StrictParams;
+using mbot_common::StrictParams;
 
 namespace
 {
@@ -168,7 +168,7 @@ geometry_msgs::PoseStamped toPoseStamped(const Pose2D& p, const std::string& fra
   geometry_msgs::PoseStamped out;
   out.header.frame_id = frame;
   out.header.stamp = stamp;
-  out.pose = localization::toPoseMsg(p);
+  out.pose = mbot_common::toPoseMsg(p);
   return out;
 }
 }  // namespace
@@ -234,13 +234,13 @@ std::vector<TeammateState> TeammateTracker::states(const ros::Time& now) const
     s.wz = msg->twist.twist.angular.z;
     if (source_ == Source::GROUND_TRUTH)
     {
-      s.pose = localization::toPose2D(msg->pose.pose);
+      s.pose = mbot_common::toPose2D(msg->pose.pose);
     }
     else
     {
       try
       {
-        s.pose = localization::toPose2D(
+        s.pose = mbot_common::toPose2D(
             tf_.lookupTransform(global_frame_, kv.first + "/base_footprint", ros::Time(0)).transform);
       }
       catch (const tf2::TransformException&)
@@ -260,7 +260,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   : nh_(nh), private_nh_(private_nh)
 {
   StrictParams p(private_nh_);
-  robot_ = localization::robotName(p, nh_);
+  robot_ = mbot_common::robotName(p, nh_);
   own_model_ = p.getString("model", "mbot");
   description_dir_ = ros::package::getPath("mbot_description");
   if (description_dir_.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
@@ -308,7 +308,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   // --- costmaps
   CostmapRosSettings global_defaults;
-  global_defaults.robot_base_frame = localization::prefixedFrame(robot_, "base_footprint");
+  global_defaults.robot_base_frame = mbot_common::prefixedFrame(robot_, "base_footprint");
   global_defaults.costmap.robot_radius = own_radius_;
   global_defaults.costmap.rolling_window = false;
   global_defaults.update_frequency = 5.0;
@@ -484,7 +484,7 @@ bool NavNode::robotPose(Pose2D& pose, std::string& error) const
             " s old (transform_tolerance " + std::to_string(transform_tolerance_) + " s)";
     return false;
   }
-  pose = localization::toPose2D(t.transform);
+  pose = mbot_common::toPose2D(t.transform);
   return true;
 }
 
@@ -616,7 +616,7 @@ std::string NavNode::goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, P
   if (frame.empty()) return "goal frame is empty (expected a tf frame such as '" + global_frame_ + "')";
   if (frame == global_frame_)
   {
-    out = localization::toPose2D(goal.pose);
+    out = mbot_common::toPose2D(goal.pose);
     return "";
   }
   if (!tf_->_frameExists(frame)) return "goal frame '" + frame + "' is unknown to tf";
@@ -631,7 +631,7 @@ std::string NavNode::goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, P
   {
     return "goal frame '" + frame + "' cannot be transformed to '" + global_frame_ + "': " + e.what();
   }
-  out = localization::toPose2D(transformed.pose);
+  out = mbot_common::toPose2D(transformed.pose);
   return "";
 }
 

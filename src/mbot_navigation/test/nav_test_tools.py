@@ -3,7 +3,6 @@ track, the simulator's contacts and the map. Everything waits in sim time; roste
 (wall time) catches a simulator that stopped."""
 import math
 import threading
-import time
 
 import rospy
 from actionlib_msgs.msg import GoalStatus
@@ -28,17 +27,6 @@ def wait_until(condition, timeout, what):
             return
         rospy.sleep(0.05)
     raise AssertionError("timed out after %.0f sim s waiting for %s" % (timeout, what))
-
-
-def wait_for_wall(condition, timeout, what):
-    """Poll `condition` on the wall clock, for tests that publish /clock themselves (sim time
-    only moves when the test publishes it)."""
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        if condition():
-            return
-        time.sleep(0.01)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
 
 
 def action_client(robot, timeout=60.0):

@@ -1,13 +1,11 @@
-#include "mbot_navigation/localization_core.h"
+#include "mbot_localization/localization_core.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 // ---------------------------------------------------------------- particle filter localizer
 
@@ -153,5 +151,4 @@ std::vector<GroundTruthMatcher::Match> GroundTruthMatcher::takeMatches()
   return matches;
 }
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

@@ -1,12 +1,10 @@
-#include "mbot_navigation/localization_models.h"
+#include "mbot_localization/localization_models.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 OdomModelType parseOdomModelType(const std::string& name)
 {
@@ -196,5 +194,4 @@ double LikelihoodFieldModel::likelihood(const LaserScanData& scan, const Pose2D&
   return scoreBeams(beams, compose(base_in_map, laser_in_base), range_max, config_, *field_);
 }
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

@@ -15,14 +15,12 @@
 #include <optional>
 #include <vector>
 
-#include "mbot_navigation/likelihood_field.h"
-#include "mbot_navigation/localization_math.h"
-#include "mbot_navigation/localization_models.h"
-#include "mbot_navigation/particle_filter.h"
+#include "mbot_localization/likelihood_field.h"
+#include "mbot_localization/localization_math.h"
+#include "mbot_localization/localization_models.h"
+#include "mbot_localization/particle_filter.h"
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 /// @brief All settings of the particle filter localizer (amcl's names in the comments).
 struct PfLocalizerConfig
@@ -69,7 +67,7 @@ public:
   const PoseWithCovariance& estimate() const { return estimate_; }
 
   /// @brief map -> odom from the last filter update: estimate * inverse(odom pose then).
-  Pose2D mapToOdom() const { return localization::mapToOdom(estimate_.pose, odom_at_estimate_); }
+  Pose2D mapToOdom() const { return mbot_localization::mapToOdom(estimate_.pose, odom_at_estimate_); }
 
   /// @brief Filter updates and resamplings done so far (for logs and tests).
   int updates() const { return updates_; }
@@ -154,5 +152,4 @@ private:
   int time_jumps_ = 0;
 };
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

@@ -13,9 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 /// @brief An occupancy grid as map_server publishes it: -1 unknown, 0 free, 100 occupied.
 struct OccupancyGridData
@@ -79,5 +77,4 @@ private:
 std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width,
                                              unsigned height);
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

@@ -13,12 +13,9 @@
 
 #include <mbot_common/geometry.h>
 
-#include "mbot_navigation/costmap_2d.h"  // Pose2D, shared by the whole package
-
-namespace mbot_navigation
+namespace mbot_localization
 {
-namespace localization
-{
+using mbot_common::Pose2D;          // {x, y, theta} [m, m, rad]
 using mbot_common::angleDiff;       // smallest signed difference a - b [rad], in (-pi, pi]
 using mbot_common::compose;         // a * b: pose b (given in a's frame) in a's parent frame
 using mbot_common::inverse;         // the parent frame expressed in a's frame
@@ -38,5 +35,4 @@ struct PoseWithCovariance
   std::array<double, 9> covariance{};  ///< [m^2, m^2, rad^2 on the diagonal]
 };
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

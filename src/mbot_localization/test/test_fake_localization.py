@@ -20,9 +20,9 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
-from nav_test_tools import wait_for_wall as wait_for
+from localization_test_tools import wait_for_wall as wait_for
 
-PKG = "mbot_navigation"
+PKG = "mbot_localization"
 STEPS = 25
 STEP_NS = 20 * 1000 * 1000  # 50 Hz
 START_NS = 100 * 1000 * 1000 * 1000  # t = 100 s

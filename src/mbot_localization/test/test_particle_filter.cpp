@@ -12,14 +12,13 @@
 #include <random>
 #include <vector>
 
-#include "mbot_navigation/likelihood_field.h"
-#include "mbot_navigation/localization_core.h"
-#include "mbot_navigation/localization_math.h"
-#include "mbot_navigation/localization_models.h"
-#include "mbot_navigation/particle_filter.h"
+#include "mbot_localization/likelihood_field.h"
+#include "mbot_localization/localization_core.h"
+#include "mbot_localization/localization_math.h"
+#include "mbot_localization/localization_models.h"
+#include "mbot_localization/particle_filter.h"
 
-using namespace mbot_navigation;
-using namespace mbot_navigation::localization;
+using namespace mbot_localization;
 
 namespace
 {

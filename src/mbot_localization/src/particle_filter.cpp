@@ -1,4 +1,4 @@
-#include "mbot_navigation/particle_filter.h"
+#include "mbot_localization/particle_filter.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,7 @@
 #include <string>
 #include <unordered_set>
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count,
                                       std::mt19937& rng)
@@ -155,5 +153,4 @@ PoseWithCovariance ParticleFilter::estimate() const
   return out;
 }
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

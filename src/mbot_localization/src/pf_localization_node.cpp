@@ -27,12 +27,10 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "mbot_navigation/localization_core.h"
-#include "mbot_navigation/localization_ros.h"
+#include "mbot_localization/localization_core.h"
+#include "mbot_localization/localization_ros.h"
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 class PfLocalizationNode
 {
@@ -244,8 +242,7 @@ private:
   ros::Subscriber map_sub_, scan_sub_, initial_pose_sub_;
 };
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization
 
 int main(int argc, char** argv)
 {
@@ -253,7 +250,7 @@ int main(int argc, char** argv)
   ros::NodeHandle nh, pnh("~");
   try
   {
-    mbot_navigation::localization::PfLocalizationNode node(nh, pnh);
+    mbot_localization::PfLocalizationNode node(nh, pnh);
     ros::spin();
   }
   catch (const std::exception& e)

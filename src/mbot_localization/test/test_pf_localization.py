@@ -22,9 +22,9 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from nav_test_tools import wait_for_wall as wait_for
+from localization_test_tools import wait_for_wall as wait_for
 
-PKG = "mbot_navigation"
+PKG = "mbot_localization"
 RESOLUTION = 0.05  # [m/cell]
 ORIGIN = (-0.5, -0.25)  # [m]
 WIDTH, HEIGHT = 200, 160  # [cells]

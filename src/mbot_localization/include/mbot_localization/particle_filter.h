@@ -11,12 +11,10 @@
 #include <random>
 #include <vector>
 
-#include "mbot_navigation/localization_math.h"
-#include "mbot_navigation/localization_models.h"
+#include "mbot_localization/localization_math.h"
+#include "mbot_localization/localization_models.h"
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 /// @brief Size of the particle set (amcl's min_particles/max_particles).
 ///
@@ -77,5 +75,4 @@ private:
 std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count,
                                       std::mt19937& rng);
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

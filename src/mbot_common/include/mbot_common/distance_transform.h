@@ -2,7 +2,8 @@
  * @file distance_transform.h
  * @brief The 1-D pass of the exact squared Euclidean distance transform of Felzenszwalb and
  *        Huttenlocher ("Distance Transforms of Sampled Functions", 2012), shared by the
- *        costmap's InflationLayer and the particle filter's LikelihoodField.
+ *        costmap's InflationLayer (mbot_navigation) and the particle filter's LikelihoodField
+ *        (mbot_localization). Header-only, free of ROS types.
  *
  * A 2-D transform is two 1-D passes: first along every column (giving the vertical distance to
  * the nearest obstacle), then along every row on the squared column distances. Each user keeps
@@ -13,7 +14,7 @@
 
 #include <limits>
 
-namespace mbot_navigation
+namespace mbot_common
 {
 /**
  * @brief 1-D squared distance transform: d[q] = min over p of (q - p)^2 + f[p], for q in [0, n).
@@ -66,4 +67,4 @@ inline void squaredDistanceTransform1d(const T* f, int n, T* d, int* v, double* 
   }
 }
 
-}  // namespace mbot_navigation
+}  // namespace mbot_common

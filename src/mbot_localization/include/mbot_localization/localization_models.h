@@ -11,12 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "mbot_navigation/likelihood_field.h"
-#include "mbot_navigation/localization_math.h"
+#include "mbot_localization/likelihood_field.h"
+#include "mbot_localization/localization_math.h"
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 /// @brief One hypothesis of the robot pose (base frame in the map) and its importance weight.
 struct Particle
@@ -124,5 +122,4 @@ private:
   std::shared_ptr<const LikelihoodField> field_;
 };
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

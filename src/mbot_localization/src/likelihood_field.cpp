@@ -1,15 +1,13 @@
-#include "mbot_navigation/likelihood_field.h"
+#include "mbot_localization/likelihood_field.h"
 
-#include "mbot_navigation/distance_transform.h"
+#include <mbot_common/distance_transform.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 namespace
 {
@@ -32,14 +30,14 @@ std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupie
   for (unsigned x = 0; x < width; ++x)
   {
     for (unsigned y = 0; y < height; ++y) f[y] = grid[static_cast<size_t>(y) * width + x];
-    squaredDistanceTransform1d(f.data(), static_cast<int>(height), d.data(), v.data(), z.data());
+    mbot_common::squaredDistanceTransform1d(f.data(), static_cast<int>(height), d.data(), v.data(), z.data());
     for (unsigned y = 0; y < height; ++y) grid[static_cast<size_t>(y) * width + x] = d[y];
   }
   for (unsigned y = 0; y < height; ++y)
   {
     const size_t row = static_cast<size_t>(y) * width;
     for (unsigned x = 0; x < width; ++x) f[x] = grid[row + x];
-    squaredDistanceTransform1d(f.data(), static_cast<int>(width), d.data(), v.data(), z.data());
+    mbot_common::squaredDistanceTransform1d(f.data(), static_cast<int>(width), d.data(), v.data(), z.data());
     for (unsigned x = 0; x < width; ++x) grid[row + x] = d[x];
   }
   return grid;
@@ -97,5 +95,4 @@ bool LikelihoodField::isFree(double x, double y) const
   return worldToMap(x, y, mx, my) && free_[index(mx, my)] != 0;
 }
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization

@@ -22,12 +22,10 @@
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "mbot_navigation/localization_core.h"
-#include "mbot_navigation/localization_ros.h"
+#include "mbot_localization/localization_core.h"
+#include "mbot_localization/localization_ros.h"
 
-namespace mbot_navigation
-{
-namespace localization
+namespace mbot_localization
 {
 class FakeLocalizationNode
 {
@@ -107,8 +105,7 @@ private:
   ros::Subscriber odom_sub_, truth_sub_;
 };
 
-}  // namespace localization
-}  // namespace mbot_navigation
+}  // namespace mbot_localization
 
 int main(int argc, char** argv)
 {
@@ -116,7 +113,7 @@ int main(int argc, char** argv)
   ros::NodeHandle nh, pnh("~");
   try
   {
-    mbot_navigation::localization::FakeLocalizationNode node(nh, pnh);
+    mbot_localization::FakeLocalizationNode node(nh, pnh);
     ros::spin();
   }
   catch (const std::exception& e)
