@@ -219,7 +219,8 @@ WorldConfig loadWorldConfig(const std::string& path)
     const YAML::Node& item = movers[i];
     MovingObstacleConfig mover;
     mover.key = Reader::index("moving_obstacles", i);
-    r.checkKeys(item, mover.key, {"name", "shape", "size", "radius", "waypoints", "speed", "mode"},
+    r.checkKeys(item, mover.key,
+                {"name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius"},
                 {"shape", "waypoints", "speed"});
     mover.name = item["name"] ? readName(r, item["name"], Reader::join(mover.key, "name"))
                               : "moving_obstacle_" + std::to_string(i);
@@ -248,6 +249,15 @@ WorldConfig loadWorldConfig(const std::string& path)
       else
         r.expected(Reader::join(mover.key, "mode"), "loop or ping_pong", item["mode"]);
     }
+    if (item["yielding"])
+    {
+      const std::string key = Reader::join(mover.key, "yielding");
+      const std::string what = "a number in [0, 1] (0: it does not give way)";
+      mover.yielding = r.number(item["yielding"], key, what);
+      if (mover.yielding < 0.0 || mover.yielding > 1.0) r.expected(key, what, item["yielding"]);
+    }
+    if (item["personal_radius"])
+      mover.personal_radius = positive(r, item["personal_radius"], Reader::join(mover.key, "personal_radius"), "[m]");
     config.moving_obstacles.push_back(mover);
   }
 

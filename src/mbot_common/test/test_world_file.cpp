@@ -61,6 +61,10 @@ TEST(WorldFile, ReadsEveryKey)
   EXPECT_DOUBLE_EQ(c.moving_obstacles[0].speed, 0.6);
   EXPECT_EQ(c.moving_obstacles[1].name, "moving_obstacle_1");
   EXPECT_EQ(c.moving_obstacles[1].mode, MovingObstacleConfig::Mode::LOOP);  // the default
+  EXPECT_DOUBLE_EQ(c.moving_obstacles[0].yielding, 0.5);
+  EXPECT_DOUBLE_EQ(c.moving_obstacles[0].personal_radius, 1.2);
+  EXPECT_DOUBLE_EQ(c.moving_obstacles[1].yielding, 1.0);  // the defaults
+  EXPECT_DOUBLE_EQ(c.moving_obstacles[1].personal_radius, 0.8);
   EXPECT_DOUBLE_EQ(c.noise.laser_range, 0.01);
   EXPECT_DOUBLE_EQ(c.noise.odom_linear, 0.02);
   EXPECT_DOUBLE_EQ(c.noise.odom_angular, 0.03);

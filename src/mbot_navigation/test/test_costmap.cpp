@@ -225,6 +225,47 @@ TEST_F(ObstacleLayerTest, ObstacleRangeAndInvalidRanges)
   EXPECT_EQ(lethal, 1);
 }
 
+/// A wall of 41 cells (x = 2.525 m, y from 1.025 to 3.025 m) scanned 50 times from (0.525, 2.025)
+/// by one beam per wall cell, each beam dropping out with probability 0.3 and then reading
+/// `dropped` instead of its range. @return how many wall cells are LETHAL after the last scan.
+int wallCellsLeftUnderDropout(double dropped)
+{
+  LayeredCostmap costmap(staticConfig(6.0, 6.0, 0.0));
+  auto& layer = static_cast<ObstacleLayer&>(costmap.addLayer(std::make_unique<ObstacleLayer>()));
+  const Pose2D robot{0.525, 2.025, 0.0};
+  costmap.updateMap(robot);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int k = 0; k < 50; ++k)
+  {
+    ScanObservation s;
+    s.origin_x = robot.x;
+    s.origin_y = robot.y;
+    s.range_max = 8.0;
+    for (int j = 0; j <= 40; ++j)
+    {
+      s.addEndpoint(2.525, 1.025 + 0.05 * j);
+      if (uniform(rng) < 0.3) s.beams.back().range = dropped;
+    }
+    layer.addObservation(s);
+    costmap.updateMap(robot);
+  }
+  int lethal = 0;
+  for (int j = 0; j <= 40; ++j) lethal += costAt(costmap.costmap(), 2.525, 1.025 + 0.05 * j) == cost::LETHAL;
+  return lethal;
+}
+
+TEST(ObstacleLayerDropout, NaNBeamsNeitherMarkNorClearSoAnObstacleStays)
+{
+  // REP-117: a dropped beam (NaN, "invalid") says nothing; the wall stays whole.
+  EXPECT_EQ(wallCellsLeftUnderDropout(std::nan("")), 41);
+  // What +Inf ("nothing in range") would do instead: it clears the cells it passes, so the last
+  // scan's dropped beams erase about 30 % of the wall (the reason dropouts must not be +Inf).
+  const int left_with_inf = wallCellsLeftUnderDropout(kInf);
+  EXPECT_LT(left_with_inf, 38);
+  EXPECT_GT(left_with_inf, 20);
+}
+
 TEST(LayeredCostmap, MaximumCombinationAndUnknownRevealedByClearing)
 {
   // Static map: a lethal cell at (10, 10) and unknown cells in row 20; tracking unknown space.

@@ -184,8 +184,8 @@ void StageRos::addRobotIo(int id)
   io->cmd_vel = nh_.subscribe<geometry_msgs::Twist>(
       ns + "cmd_vel", 1, [this, id](const geometry_msgs::Twist::ConstPtr& msg) { onCmdVel(id, msg); },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  io->cmd_pose = nh_.subscribe<geometry_msgs::Pose2D>(
-      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose2D::ConstPtr& msg) { onCmdPose(id, msg); });
+  io->cmd_pose = nh_.subscribe<geometry_msgs::Pose>(
+      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose::ConstPtr& msg) { onCmdPose(id, msg); });
 
   // Message parts that never change, filled once.
   const mbot_description::RobotModel& m = world_->robotModel(id);
@@ -556,12 +556,21 @@ void StageRos::onHeartbeat(const std_msgs::Header::ConstPtr& msg)
   if (p.ignored && p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9) p.ignored = false;  // caught up
 }
 
-void StageRos::onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg)
+/// As stage_ros: a geometry_msgs/Pose in the map frame; z, roll and pitch are ignored.
+void StageRos::onCmdPose(int robot, const geometry_msgs::Pose::ConstPtr& msg)
 {
   if (!world_->hasRobot(robot)) return;
+  const geometry_msgs::Quaternion& q = msg->orientation;
+  const double yaw = mbot_common::yawOf(q.x, q.y, q.z, q.w);
+  if (std::isnan(yaw))
+  {
+    ROS_WARN("stage_node: cmd_pose: %s: the orientation is not a rotation (zero or NaN quaternion)",
+             world_->robotName(robot).c_str());
+    return;
+  }
   try
   {
-    world_->teleport(world_->robotName(robot), Pose2D{msg->x, msg->y, msg->theta});
+    world_->teleport(world_->robotName(robot), Pose2D{msg->position.x, msg->position.y, yaw});
   }
   catch (const std::exception& e)
   {

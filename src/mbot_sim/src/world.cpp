@@ -313,7 +313,9 @@ struct Obstacle
 };
 
 /// A kinematic obstacle on a closed route (loop: back to the first waypoint; ping_pong: the
-/// waypoints back again), at constant speed.
+/// waypoints back again). A blind one (yielding 0) is where its speed has carried it along the
+/// route (moveTo); a walker (yielding > 0) walks from waypoint to waypoint and gives way
+/// (Impl::planWalk).
 struct Mover
 {
   BodyTag tag;
@@ -327,6 +329,14 @@ struct Mover
   size_t segment = 0;             ///< cached: the route segment it is on
   Pose2D pose;
   double vx = 0.0, vy = 0.0;      ///< [m/s] map frame
+  // walker only
+  size_t next = 1;                ///< the route point it walks to
+  double reach = 0.0;             ///< [m] radius of the circle around its outline
+  GeomPtr probe;                  ///< its outline in no space, to test a next position against walls
+  double side = 1.0;              ///< +1: passes bodies on its right, -1: on its left
+  double stuck_time = 0.0;        ///< [s] how long it has made no headway
+
+  bool walker() const { return config.yielding > 0.0; }
 
   /// Pose at sim time t.
   void moveTo(double t)
@@ -703,6 +713,10 @@ struct World::Impl
     claimName(config.name, "moving obstacle");
     if (config.waypoints.size() < 2) throw SimError("moving obstacle " + config.name + ": expected at least 2 waypoints");
     if (!(config.speed > 0.0)) throw SimError("moving obstacle " + config.name + ": expected a speed > 0");
+    if (!(config.yielding >= 0.0 && config.yielding <= 1.0))
+      throw SimError("moving obstacle " + config.name + ": expected a yielding in [0, 1]");
+    if (!(config.personal_radius > 0.0))
+      throw SimError("moving obstacle " + config.name + ": expected a personal_radius > 0 [m]");
     auto m = std::make_unique<Mover>();
     m->config = config;
     m->outline = outlineOf(config.shape);
@@ -730,6 +744,8 @@ struct World::Impl
     dBodySetKinematic(m->body.get());  // infinite mass: robots cannot push it
     m->geom = makeGeom(m->outline, 0.0, false);
     dGeomSetBody(m->geom.get(), m->body.get());
+    m->reach = reachOf(m->outline);
+    m->probe = makeGeom(m->outline, 0.0, false);
     dGeomSetCategoryBits(m->geom.get(), kMovingBit);
     dGeomSetCollideBits(m->geom.get(), kRobotBit);
     dGeomSetData(m->geom.get(), &m->tag);
@@ -790,15 +806,178 @@ struct World::Impl
       r->odom_twist = Twist2D{};
       std::fill(r->joints.position.begin(), r->joints.position.end(), 0.0);
       std::fill(r->joints.velocity.begin(), r->joints.velocity.end(), 0.0);
+      // Samples a latency fault still holds were measured before the reset: delivered later they
+      // would put the robot back where it was (old odometry after the new identity).
+      r->pending_odom.clear();
+      r->pending_joints.clear();
+      r->pending_scans.clear();
+      r->last_release = time();
     }
     for (auto& m : movers)
     {
       m->start_time = time();
       m->segment = 0;
-      m->moveTo(time());
+      m->next = 1;
+      m->side = 1.0;
+      m->stuck_time = 0.0;
+      m->moveTo(time());  // at the first waypoint, facing the second
       placeMover(*m);
     }
     active_pairs.clear();
+  }
+
+  // ---- walkers (moving obstacles that give way) ----------------------------------------------
+  /// A body a walker keeps its distance from: the circle around its outline.
+  struct BodyCircle
+  {
+    double x, y, radius;
+    const Mover* mover;  ///< nullptr for a robot
+  };
+  std::vector<BodyCircle> bodies;  ///< robots and movers at the start of the step (reused)
+
+  static double reachOf(const Outline& o) { return o.is_box ? std::hypot(o.half_length, o.half_width) : o.radius; }
+
+  void collectBodies()
+  {
+    bodies.clear();
+    for (const auto& r : robots)
+    {
+      const Pose2D c = outlinePose(r->outline, r->pose);
+      bodies.push_back(BodyCircle{c.x, c.y, reachOf(r->outline), nullptr});
+    }
+    for (const auto& m : movers) bodies.push_back(BodyCircle{m->pose.x, m->pose.y, m->reach, m.get()});
+  }
+
+  /// True when the mover's outline at (x, y, yaw) overlaps a wall or a static obstacle.
+  bool hitsStatic(Mover& m, double x, double y, double yaw) const
+  {
+    setGeomPose(m.probe.get(), x, y, yaw);
+    OverlapQuery q;
+    q.query = m.probe.get();
+    dSpaceCollide2(m.probe.get(), reinterpret_cast<dGeomID>(static_space.get()), &q, &overlapCallback);
+    return q.found != nullptr;
+  }
+
+  /// A step with velocity (vx, vy) is allowed when it brings the walker no closer than kMinGap
+  /// to any body it is not already closer to, and into no wall it is not already in.
+  bool stepAllowed(Mover& m, double vx, double vy, double dt, bool in_wall) const
+  {
+    constexpr double kMinGap = 0.05;  // [m] between outlines; contacts begin at the 0.01 m margin
+    const double x = m.pose.x + vx * dt, y = m.pose.y + vy * dt;
+    for (const BodyCircle& b : bodies)
+    {
+      if (b.mover == &m) continue;
+      const double gap_now = std::hypot(m.pose.x - b.x, m.pose.y - b.y) - m.reach - b.radius;
+      const double gap_next = std::hypot(x - b.x, y - b.y) - m.reach - b.radius;
+      if (gap_next < kMinGap && gap_next < gap_now - 1e-12) return false;
+    }
+    if (in_wall || (vx == 0.0 && vy == 0.0)) return true;
+    const double yaw = std::hypot(vx, vy) > 1e-9 ? std::atan2(vy, vx) : m.pose.theta;
+    return !hitsStatic(m, x, y, yaw);
+  }
+
+  /// The walker's velocity for this step (m.vx, m.vy), social-force style: it heads for its next
+  /// waypoint at its speed; robots and other movers within personal_radius of its outline push
+  /// it away and, when they are ahead, steer it around them (to its right when head-on), both
+  /// scaled by `yielding`; then the step is checked: it never closes in on a body nearer than
+  /// kMinGap (it stops instead: it cannot be pushed, so it must not walk into anyone) and
+  /// never enters a wall (it slides along, or waits).
+  void planWalk(Mover& m, double dt)
+  {
+    const MovingObstacleConfig& c = m.config;
+    // 1. The waypoint: reached when within one step, or when a body stands on it and the
+    //    walker is next to it (it would wait there for ever).
+    Point2D target;
+    double dist = 0.0;
+    for (size_t guard = 0; guard < m.route.size(); ++guard)
+    {
+      target = m.route[m.next];
+      dist = std::hypot(target.x - m.pose.x, target.y - m.pose.y);
+      bool reached = dist <= std::max(c.speed * dt, 1e-3);
+      if (!reached && dist <= m.reach + c.personal_radius)
+        for (const BodyCircle& b : bodies)
+          reached = reached || (b.mover != &m && std::hypot(target.x - b.x, target.y - b.y) < b.radius + m.reach);
+      if (!reached) break;
+      m.next = m.next + 1 < m.route.size() ? m.next + 1 : 1;  // route.back() == route.front()
+    }
+    const double ex = dist > 1e-9 ? (target.x - m.pose.x) / dist : 0.0;
+    const double ey = dist > 1e-9 ? (target.y - m.pose.y) / dist : 0.0;
+
+    // 2. Social forces, in units of its speed.
+    double fx = 0.0, fy = 0.0;
+    for (const BodyCircle& b : bodies)
+    {
+      if (b.mover == &m) continue;
+      double nx = m.pose.x - b.x, ny = m.pose.y - b.y;  // from the body to the walker
+      const double d = std::hypot(nx, ny);
+      if (d < 1e-9) continue;
+      nx /= d;
+      ny /= d;
+      const double gap = d - m.reach - b.radius;
+      if (gap >= c.personal_radius) continue;
+      const double s = std::min(1.0, (c.personal_radius - gap) / c.personal_radius);  // 0 at the edge
+      const double ahead = -(nx * ex + ny * ey);  // 1: straight ahead, -1: behind
+      const double weight = 0.5 + 0.5 * std::max(0.0, ahead);  // what is ahead matters more
+      fx += 2.0 * s * s * weight * nx;
+      fy += 2.0 * s * s * weight * ny;
+      if (ahead > 0.0)
+      {
+        // Around it: the tangent that goes on forwards, preferably on its side (right, as
+        // people keep right; the left after it got stuck, e.g. with a wall on its right).
+        double tx = -ny, ty = nx;
+        if (tx * ex + ty * ey + 0.3 * m.side * (tx * ey - ty * ex) < 0.0)
+        {
+          tx = -tx;
+          ty = -ty;
+        }
+        fx += 1.5 * s * ahead * tx;
+        fy += 1.5 * s * ahead * ty;
+      }
+    }
+    double vx = c.speed * (ex + c.yielding * fx), vy = c.speed * (ey + c.yielding * fy);
+    const double v = std::hypot(vx, vy);
+    if (v > c.speed)
+    {
+      vx *= c.speed / v;
+      vy *= c.speed / v;
+    }
+
+    // 3. The step it may take: as wished; without the part towards bodies it is close to;
+    //    sliding along a wall; or none.
+    const bool in_wall = hitsStatic(m, m.pose.x, m.pose.y, m.pose.theta);
+    double px = vx, py = vy;
+    for (const BodyCircle& b : bodies)
+    {
+      if (b.mover == &m) continue;
+      double nx = m.pose.x - b.x, ny = m.pose.y - b.y;
+      const double d = std::hypot(nx, ny);
+      if (d < 1e-9 || d - m.reach - b.radius > c.personal_radius) continue;
+      nx /= d;
+      ny /= d;
+      const double towards = px * nx + py * ny;  // < 0: closing in
+      if (towards < 0.0)
+      {
+        px -= towards * nx;
+        py -= towards * ny;
+      }
+    }
+    const double candidates[5][2] = {{vx, vy}, {px, py}, {px, 0.0}, {0.0, py}, {0.0, 0.0}};
+    for (const auto& cand : candidates)
+      if (stepAllowed(m, cand[0], cand[1], dt, in_wall))
+      {
+        m.vx = cand[0];
+        m.vy = cand[1];
+        break;
+      }
+
+    // 4. No headway for a second (a body ahead and no way past on this side): try the other.
+    const bool headway = m.vx * ex + m.vy * ey > 0.1 * c.speed;
+    m.stuck_time = headway ? 0.0 : m.stuck_time + dt;
+    if (m.stuck_time > 1.0)
+    {
+      m.side = -m.side;
+      m.stuck_time = 0.0;
+    }
   }
 
   // ---- the step ----------------------------------------------------------------------------
@@ -1036,11 +1215,14 @@ struct World::Impl
     const double dropout = r.faults.laser_dropout;
     if (sigma <= 0.0 && dropout <= 0.0) return;
     const float inf = std::numeric_limits<float>::infinity();
+    const float invalid = std::numeric_limits<float>::quiet_NaN();
     for (float& range : r.scan.ranges)
     {
+      // A dropped beam measured nothing: NaN (REP-117 "invalid"), not +Inf, which would claim
+      // that nothing is in range and make costmaps clear real obstacles.
       if (dropout > 0.0 && r.uniform(r.rng) < dropout)
       {
-        range = inf;
+        range = invalid;
         continue;
       }
       if (sigma > 0.0 && std::isfinite(range))
@@ -1120,7 +1302,12 @@ struct World::Impl
   {
     const double dt = settings.physics_step;
     for (auto& r : robots) driveRobot(*r, dt);
-    for (auto& m : movers) dBodySetLinearVel(m->body.get(), m->vx, m->vy, 0.0);
+    if (std::any_of(movers.begin(), movers.end(), [](const auto& m) { return m->walker(); })) collectBodies();
+    for (auto& m : movers)
+    {
+      if (m->walker()) planWalk(*m, dt);
+      dBodySetLinearVel(m->body.get(), m->vx, m->vy, 0.0);
+    }
 
     hits.clear();
     dSpaceCollide(dynamic_space.get(), this, &nearCallback);
@@ -1138,7 +1325,16 @@ struct World::Impl
     }
     for (auto& m : movers)
     {
-      m->moveTo(time());
+      if (m->walker())
+      {
+        m->pose.x += m->vx * dt;
+        m->pose.y += m->vy * dt;
+        if (std::hypot(m->vx, m->vy) > 1e-9) m->pose.theta = std::atan2(m->vy, m->vx);
+      }
+      else
+      {
+        m->moveTo(time());
+      }
       placeMover(*m);
     }
     reportContacts();

@@ -9,8 +9,8 @@ import unittest
 import rospy
 import rostest
 import tf2_ros
-from geometry_msgs.msg import Pose2D, Twist
-from mbot_common.geometry import yaw_of
+from geometry_msgs.msg import Pose, Pose2D, Twist
+from mbot_common.geometry import quaternion_from_yaw, yaw_of
 from mbot_msgs.srv import RemoveRobot, SetFault, SetFaultRequest, SpawnRobot, TeleportRobot
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
@@ -25,6 +25,21 @@ from sim_test_tools import (Recorder, drive_until, publish_for, wait_for_connect
 def pose2d(x, y, theta):
     p = Pose2D()
     p.x, p.y, p.theta = x, y, theta
+    return p
+
+
+def pose3d(x, y, z, yaw, roll=0.0, scale=1.0):
+    """A geometry_msgs/Pose at (x, y, z) turned by yaw, then roll about the turned x axis; the
+    quaternion is multiplied by scale (a yaw reader must not need a unit quaternion)."""
+    p = Pose()
+    p.position.x, p.position.y, p.position.z = x, y, z
+    _, _, qz, qw = quaternion_from_yaw(yaw)
+    cr, sr = math.cos(0.5 * roll), math.sin(0.5 * roll)
+    # q_yaw * q_roll (Hamilton product of (0, 0, qz, qw) and (sr, 0, 0, cr))
+    p.orientation.x = scale * qw * sr
+    p.orientation.y = scale * qz * sr
+    p.orientation.z = scale * qz * cr
+    p.orientation.w = scale * qw * cr
     return p
 
 
@@ -129,9 +144,11 @@ class SimServices(unittest.TestCase):
         rospy.sleep(0.5)
         self.assertAlmostEqual(self.pose_of("robot_1")[0], 5.0, delta=1e-6)  # unchanged
 
-        pub = rospy.Publisher("/robot_1/cmd_pose", Pose2D, queue_size=1, latch=True)
+        # cmd_pose is a geometry_msgs/Pose as in stage_ros: z, roll and pitch are ignored, the yaw
+        # comes from the quaternion (here one with roll 0.3 and a non-unit length).
+        pub = rospy.Publisher("/robot_1/cmd_pose", Pose, queue_size=1, latch=True)
         wait_for_connection(pub)
-        pub.publish(pose2d(3.0, 6.5, -1.0))
+        pub.publish(pose3d(3.0, 6.5, 0.7, yaw=-1.0, roll=0.3, scale=2.0))
         x, y, yaw = self.wait_for_pose("robot_1", 3.0, 6.5, "robot_1 moved by cmd_pose")
         self.assertAlmostEqual(x, 3.0, delta=1e-6)
         self.assertAlmostEqual(y, 6.5, delta=1e-6)
@@ -149,7 +166,9 @@ class SimServices(unittest.TestCase):
         rospy.sleep(0.5)
         scans = [m for m in self.scan0.stamped_after(t0) if m.header.stamp.to_sec() <= t0 + 2.0]
         self.assertGreaterEqual(len(scans), 19)
-        dropped = sum(1 for s in scans for i in finite if math.isinf(s.ranges[i]))
+        # a dropped beam reads NaN (REP-117 invalid), not +Inf
+        dropped = sum(1 for s in scans for i in finite if math.isnan(s.ranges[i]))
+        self.assertEqual(sum(1 for s in scans for i in finite if math.isinf(s.ranges[i])), 0)
         fraction = dropped / float(len(scans) * len(finite))
         self.assertAlmostEqual(fraction, 0.5, delta=0.05)  # > 6 sigma for > 4500 beams
 
@@ -160,7 +179,7 @@ class SimServices(unittest.TestCase):
         cleared = self.scan0.stamped_after(t1)
         self.assertGreaterEqual(len(cleared), 5)
         for s in cleared:
-            self.assertEqual(sum(1 for i in finite if math.isinf(s.ranges[i])), 0)
+            self.assertEqual(sum(1 for i in finite if not math.isfinite(s.ranges[i])), 0)
 
         for req, expected in [(fault("robot_0", laser_dropout=1.5), "laser_dropout"),
                               (fault("robot_0", laser_dropout=-0.1), "laser_dropout"),

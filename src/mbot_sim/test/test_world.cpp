@@ -85,7 +85,9 @@ struct Recorder : SensorListener
   std::map<int, std::vector<ScanSample>> scans;
   std::map<int, std::vector<JointStateSample>> joints;
   std::vector<ContactEvent> contacts;
-  std::vector<double> odom_release_times;  ///< sim time at which each odom sample arrived
+  std::vector<double> odom_release_times;   ///< sim time at which each odom sample arrived
+  std::vector<double> truth_release_times;  ///< sim time at which each ground truth sample arrived
+  std::vector<double> scan_release_times;   ///< sim time at which each scan arrived
   const World* world = nullptr;
 
   void onOdometry(int r, const OdometrySample& s) override
@@ -93,8 +95,16 @@ struct Recorder : SensorListener
     odom[r].push_back(s);
     if (world) odom_release_times.push_back(world->time());
   }
-  void onGroundTruth(int r, const GroundTruthSample& s) override { truth[r].push_back(s); }
-  void onScan(int r, const ScanSample& s) override { scans[r].push_back(s); }
+  void onGroundTruth(int r, const GroundTruthSample& s) override
+  {
+    truth[r].push_back(s);
+    if (world) truth_release_times.push_back(world->time());
+  }
+  void onScan(int r, const ScanSample& s) override
+  {
+    scans[r].push_back(s);
+    if (world) scan_release_times.push_back(world->time());
+  }
   void onJointState(int r, const JointStateSample& s) override { joints[r].push_back(s); }
   void onContact(const ContactEvent& e) override { contacts.push_back(e); }
 
@@ -295,6 +305,7 @@ TEST(Contacts, MovingObstacleFollowsItsPathAndCannotBePushed)
   person.waypoints = {{-2.0, 0.0}, {2.0, 0.0}};
   person.speed = 0.5;
   person.mode = MovingObstacleConfig::Mode::PING_PONG;
+  person.yielding = 0.0;  // blind: it keeps to its timetable whatever is in the way
   world.addMovingObstacle(person);
   // A robot in the way, driving against the person.
   const int id = world.addRobot("robot_0", diffModel(), Pose2D{1.0, 0.0, kPi});
@@ -324,6 +335,7 @@ TEST(Contacts, LoopingMoverReturnsToTheFirstWaypoint)
   cart.shape.width = 0.4;
   cart.waypoints = {{0.0, 0.0}, {3.0, 0.0}, {3.0, 4.0}};  // loop length 3 + 4 + 5 = 12 m
   cart.speed = 1.0;
+  cart.yielding = 0.0;
   world.addMovingObstacle(cart);
   run(world, 5.0);  // 3 m along x, then 2 m up
   Pose2D p = world.obstacles().front().pose;
@@ -334,6 +346,189 @@ TEST(Contacts, LoopingMoverReturnsToTheFirstWaypoint)
   p = world.obstacles().front().pose;
   EXPECT_NEAR(p.x, 0.0, 1e-6);
   EXPECT_NEAR(p.y, 0.0, 1e-6);
+}
+
+// ---- walkers (moving obstacles that give way) --------------------------------------------------
+
+namespace
+{
+MovingObstacleConfig walkerConfig(const std::string& name, std::vector<Point2D> waypoints, double yielding = 1.0)
+{
+  MovingObstacleConfig person;
+  person.name = name;
+  person.shape.type = ShapeConfig::Type::CYLINDER;
+  person.shape.radius = 0.25;
+  person.waypoints = std::move(waypoints);
+  person.speed = 0.6;
+  person.mode = MovingObstacleConfig::Mode::PING_PONG;
+  person.yielding = yielding;
+  return person;
+}
+
+/// What a walker did over a run: how close it came to each waypoint and to a robot, how far it
+/// left the line of its route (y = route_y) and the contacts.
+struct WalkLog
+{
+  std::vector<double> closest_to_waypoint;
+  double min_gap = 1e9;        ///< [m] between its outline and the robot's
+  double max_deviation = 0.0;  ///< [m] from the line y = route_y
+  size_t contacts = 0;
+};
+
+/// Step `world` for `seconds` and log obstacle `index` (a cylinder of radius 0.25) against
+/// robot `robot` (round, radius 0.15; -1: none). `robot_cmd` is repeated at 10 Hz when set.
+WalkLog walk(World& world, size_t index, const std::vector<Point2D>& waypoints, double route_y, int robot,
+             double seconds, const Twist2D* robot_cmd = nullptr)
+{
+  Recorder rec;
+  world.setListener(&rec);
+  WalkLog log;
+  log.closest_to_waypoint.assign(waypoints.size(), 1e9);
+  const int steps = static_cast<int>(std::lround(seconds / world.physicsStep()));
+  for (int i = 0; i < steps; ++i)
+  {
+    if (robot_cmd && i % 10 == 0) world.setCommand(robot, *robot_cmd);
+    world.step();
+    const Pose2D p = world.obstacles()[index].pose;
+    for (size_t k = 0; k < waypoints.size(); ++k)
+      log.closest_to_waypoint[k] =
+          std::min(log.closest_to_waypoint[k], std::hypot(p.x - waypoints[k].x, p.y - waypoints[k].y));
+    log.max_deviation = std::max(log.max_deviation, std::abs(p.y - route_y));
+    if (robot >= 0)
+    {
+      const Pose2D r = world.groundTruth(robot);
+      log.min_gap = std::min(log.min_gap, std::hypot(p.x - r.x, p.y - r.y) - 0.25 - 0.15);
+    }
+  }
+  log.contacts = rec.contacts.size();
+  world.setListener(nullptr);
+  return log;
+}
+}  // namespace
+
+TEST(Walker, AloneItWalksItsRouteAtItsSpeed)
+{
+  World world(openMap(), WorldSettings{});
+  const std::vector<Point2D> route = {{0.0, 0.0}, {3.0, 0.0}, {3.0, 4.0}};
+  MovingObstacleConfig person = walkerConfig("person_1", route);
+  person.mode = MovingObstacleConfig::Mode::LOOP;  // 3 + 4 + 5 = 12 m: 20 s at 0.6 m/s
+  world.addMovingObstacle(person);
+  const WalkLog first_lap = walk(world, 0, route, 0.0, -1, 19.0);
+  for (double d : first_lap.closest_to_waypoint) EXPECT_LT(d, 0.01);
+  // Nobody near: at its speed along the route, the same as a blind mover (to a step per corner).
+  run(world, 1.0);
+  const Pose2D p = world.obstacles().front().pose;
+  EXPECT_LT(std::hypot(p.x, p.y), 0.03);
+}
+
+TEST(Walker, StepsAroundARobotStandingOnItsPathAndStillReachesItsWaypoints)
+{
+  const std::vector<Point2D> route = {{-3.0, 0.0}, {3.0, 0.0}};
+  for (double yielding : {1.0, 0.3})
+  {
+    World world(openMap(), WorldSettings{});
+    world.addMovingObstacle(walkerConfig("person_1", route, yielding));
+    const int robot = world.addRobot("robot_0", diffModel(), Pose2D{0.0, 0.0, 0.0});  // on the path
+    const WalkLog log = walk(world, 0, route, 0.0, robot, 30.0);  // there and back: 20 s alone
+    EXPECT_EQ(log.contacts, 0u) << "yielding " << yielding;
+    EXPECT_GT(log.min_gap, 0.04) << "yielding " << yielding;
+    for (double d : log.closest_to_waypoint) EXPECT_LT(d, 0.01) << "yielding " << yielding;
+    EXPECT_GT(log.max_deviation, 0.4) << "yielding " << yielding;  // around, not through
+    EXPECT_NEAR(world.groundTruth(robot).x, 0.0, 1e-9);  // and it never pushed the robot
+  }
+  // Blind (yielding 0), the same walk runs into the robot: what the walker above avoids.
+  World world(openMap(), WorldSettings{});
+  world.addMovingObstacle(walkerConfig("person_1", route, 0.0));
+  const int robot = world.addRobot("robot_0", diffModel(), Pose2D{0.0, 0.0, 0.0});
+  EXPECT_GT(walk(world, 0, route, 0.0, robot, 30.0).contacts, 0u);
+}
+
+TEST(Walker, YieldingSetsHowEarlyAndHowFarItGivesWay)
+{
+  const std::vector<Point2D> route = {{-3.0, 0.0}, {3.0, 0.0}};
+  std::vector<double> deviation;
+  for (double yielding : {0.2, 0.5, 1.0})
+  {
+    World world(openMap(), WorldSettings{});
+    world.addMovingObstacle(walkerConfig("person_1", route, yielding));
+    // A robot just off the path: a walker that yields more keeps further from it.
+    const int robot = world.addRobot("robot_0", diffModel(), Pose2D{0.0, 0.45, 0.0});
+    const WalkLog log = walk(world, 0, route, 0.0, robot, 10.0);
+    EXPECT_EQ(log.contacts, 0u);
+    deviation.push_back(log.max_deviation);
+  }
+  EXPECT_LT(deviation[0], deviation[1]);
+  EXPECT_LT(deviation[1], deviation[2]);
+}
+
+TEST(Walker, GivesWayToARobotDrivingAtIt)
+{
+  World world(openMap(), WorldSettings{});
+  const std::vector<Point2D> route = {{-3.0, 0.0}, {3.0, 0.0}};
+  world.addMovingObstacle(walkerConfig("person_1", route));
+  // A robot driving straight along the path towards the walker, not steering at all.
+  const int robot = world.addRobot("robot_0", diffModel(), Pose2D{3.0, 0.0, kPi});
+  const Twist2D cmd{0.3, 0.0, 0.0};
+  const WalkLog log = walk(world, 0, route, 0.0, robot, 12.0, &cmd);
+  EXPECT_EQ(log.contacts, 0u);
+  EXPECT_GT(log.min_gap, 0.0);
+  EXPECT_LT(world.groundTruth(robot).x, -0.5);  // the robot went past it
+}
+
+TEST(Walker, TwoWalkersPassEachOther)
+{
+  World world(openMap(), WorldSettings{});
+  const std::vector<Point2D> route = {{-3.0, 0.0}, {3.0, 0.0}};
+  world.addMovingObstacle(walkerConfig("person_1", route));
+  world.addMovingObstacle(walkerConfig("person_2", {{3.0, 0.0}, {-3.0, 0.0}}));
+  double min_distance = 1e9;
+  for (int i = 0; i < 1000; ++i)
+  {
+    world.step();
+    const auto o = world.obstacles();
+    min_distance = std::min(min_distance, std::hypot(o[0].pose.x - o[1].pose.x, o[0].pose.y - o[1].pose.y));
+  }
+  EXPECT_GT(min_distance, 0.5 + 0.04);  // two radii and the minimum gap
+  const auto o = world.obstacles();
+  EXPECT_GT(o[0].pose.x, 2.0);  // both got through
+  EXPECT_LT(o[1].pose.x, -2.0);
+}
+
+TEST(Walker, ARobotAgainstAWallMakesItGoRoundTheOtherSideNotThroughTheWall)
+{
+  // The room's south wall is y < 0.1 m. The walker's path runs along it with 0.1 m to spare, a
+  // robot stands on the path: the right-hand way round (into the wall) is shut.
+  World world(roomMap(), WorldSettings{});
+  const std::vector<Point2D> route = {{1.0, 0.45}, {6.0, 0.45}};
+  world.addMovingObstacle(walkerConfig("person_1", route));
+  const int robot = world.addRobot("robot_0", diffModel(), Pose2D{3.5, 0.4, 0.0});
+  Recorder rec;
+  world.setListener(&rec);
+  double lowest = 1e9;
+  bool reached_far_end = false;
+  for (int i = 0; i < 2500; ++i)
+  {
+    world.step();
+    const Pose2D p = world.obstacles().front().pose;
+    lowest = std::min(lowest, p.y);
+    reached_far_end = reached_far_end || std::hypot(p.x - 6.0, p.y - 0.45) < 0.01;
+  }
+  EXPECT_GE(lowest - 0.25, 0.1 - 1e-9);  // its outline never entered the wall
+  EXPECT_TRUE(reached_far_end);
+  EXPECT_EQ(rec.contacts.size(), 0u);
+  EXPECT_NEAR(world.groundTruth(robot).y, 0.4, 1e-9);
+}
+
+TEST(Walker, ResetPutsItBackAtItsFirstWaypoint)
+{
+  World world(openMap(), WorldSettings{});
+  world.addMovingObstacle(walkerConfig("person_1", {{-3.0, 0.0}, {3.0, 0.0}}));
+  run(world, 3.0);
+  ASSERT_GT(world.obstacles().front().pose.x, -1.5);
+  world.resetPositions();
+  EXPECT_NEAR(world.obstacles().front().pose.x, -3.0, 1e-9);
+  run(world, 1.0);
+  EXPECT_NEAR(world.obstacles().front().pose.x, -3.0 + 0.6, 1e-6);
 }
 
 // ---- sensors ----------------------------------------------------------------------------------
@@ -478,15 +673,19 @@ TEST(Faults, LaserDropoutFractionMatchesTheProbability)
   f.laser_dropout = 0.3;
   world.setFaults("robot_0", f);
   run(world, 2.0);  // 20 scans, 7200 beams
-  size_t inf = 0, total = 0;
+  size_t nan = 0, inf = 0, total = 0;
   for (const auto& s : rec.scans[0])
     for (float r : s.ranges)
     {
-      inf += std::isinf(r) && r > 0;
+      nan += std::isnan(r);
+      inf += std::isinf(r);
       ++total;
     }
   ASSERT_EQ(total, 7200u);
-  EXPECT_NEAR(static_cast<double>(inf) / total, 0.3, 0.025);  // 4.6 sigma
+  // A dropped beam is NaN (REP-117 invalid), never +Inf ("nothing in range"): every beam here
+  // hits a wall, so no beam may read Inf.
+  EXPECT_NEAR(static_cast<double>(nan) / total, 0.3, 0.025);  // 4.6 sigma
+  EXPECT_EQ(inf, 0u);
 }
 
 TEST(Faults, FrozenDriveIgnoresCommands)
@@ -538,6 +737,42 @@ TEST(Faults, LatencyDelaysSamplesButKeepsTheirStamps)
   for (size_t i = 0; i < rec.odom[id].size(); ++i)
     EXPECT_NEAR(rec.odom_release_times[i] - rec.odom[id][i].stamp, 0.1, 1e-9);
   EXPECT_NEAR(rec.odom[id].front().stamp, 0.02, 1e-9);  // the first one period after the start
+  // Ground truth is an oracle: never delayed.
+  ASSERT_EQ(rec.truth[id].size(), 50u);
+  for (size_t i = 0; i < rec.truth[id].size(); ++i)
+    EXPECT_NEAR(rec.truth_release_times[i], rec.truth[id][i].stamp, 1e-9);
+}
+
+TEST(Faults, ResetDropsSamplesStillHeldBackByLatency)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  rec.world = &world;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  FaultConfig f;
+  f.sensor_latency = 0.5;
+  f.sensor_jitter = 0.05;
+  world.setFaults("robot_0", f);
+  drive(world, id, Twist2D{0.3, 0.0, 0.0}, 2.0);
+  ASSERT_GT(world.odometry(id).x, 0.3);
+  const double t_reset = world.time();
+  const size_t odom_before = rec.odom[id].size(), scans_before = rec.scans[id].size();
+  ASSERT_GT(odom_before, 50u);  // the pipeline is full: 0.5 s of samples on their way
+  world.resetPositions();
+  run(world, 2.0);
+  // Nothing measured before the reset arrives after it; what comes is new, delayed as before.
+  ASSERT_GT(rec.odom[id].size(), odom_before + 50);
+  for (size_t i = odom_before; i < rec.odom[id].size(); ++i)
+  {
+    EXPECT_GT(rec.odom[id][i].stamp, t_reset) << "sample " << i;
+    EXPECT_NEAR(rec.odom[id][i].pose.x, 0.0, 1e-9) << "old odometry after the reset";
+    EXPECT_GE(rec.odom_release_times[i] - rec.odom[id][i].stamp, 0.5 - 1e-9);
+  }
+  ASSERT_GT(rec.scans[id].size(), scans_before + 5);
+  for (size_t i = scans_before; i < rec.scans[id].size(); ++i) EXPECT_GT(rec.scans[id][i].stamp, t_reset);
+  // The delivery order did not stall: the first new odometry came 0.5 s (+ jitter) after it was measured.
+  EXPECT_LT(rec.odom_release_times[odom_before] - t_reset, 0.5 + 0.02 + 4 * 0.05);
 }
 
 TEST(Faults, OdometryDriftTurnsTheOdomFrame)

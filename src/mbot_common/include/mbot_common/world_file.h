@@ -56,7 +56,9 @@ struct ObstacleConfig
   std::string key;
 };
 
-/// @brief A kinematic body that follows waypoints (people, carts); robots cannot push it.
+/// @brief A kinematic body that follows waypoints (people, carts); robots cannot push it. A
+///        yielding one (yielding > 0) walks like a person: it slows and steps around robots and
+///        other moving obstacles that come within personal_radius, and never walks into them.
 struct MovingObstacleConfig
 {
   enum class Mode
@@ -69,6 +71,8 @@ struct MovingObstacleConfig
   std::vector<Point2D> waypoints;  ///< [m]; the first one is the start (at least 2)
   double speed = 0.5;              ///< [m/s]
   Mode mode = Mode::LOOP;
+  double yielding = 1.0;         ///< [0, 1] how much it gives way; 0: a blind waypoint follower
+  double personal_radius = 0.8;  ///< [m] it reacts to bodies this close to its outline
   std::string key;
 };
 
@@ -83,8 +87,9 @@ struct NoiseConfig
 /// @brief Faults of one robot (the fields of mbot_msgs/SetFault).
 struct FaultConfig
 {
-  double laser_dropout = 0.0;   ///< probability [0, 1] that a beam returns +Inf
-  double sensor_latency = 0.0;  ///< added delay of odom, scan, ground truth and joint states [s]
+  double laser_dropout = 0.0;   ///< probability [0, 1] that a beam returns NaN (REP-117: invalid)
+  double sensor_latency = 0.0;  ///< added delay of odom (and its tf), scan and joint states [s];
+                                ///< ground truth is an oracle and is never delayed
   double sensor_jitter = 0.0;   ///< standard deviation of an extra random delay [s]
   double odom_drift = 0.0;      ///< odometry heading drift [rad/s]
   bool drive_frozen = false;    ///< motors fail: the robot ignores cmd_vel and stops

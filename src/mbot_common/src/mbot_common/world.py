@@ -25,8 +25,10 @@ Shape = namedtuple("Shape", "type length width radius")
 Robot = namedtuple("Robot", "name model pose key")
 #: A static box or cylinder besides the map walls; pose: Pose2D in the map.
 Obstacle = namedtuple("Obstacle", "name shape pose key")
-#: A kinematic body that follows waypoints [(x, y) m] at speed [m/s]; mode "loop" or "ping_pong".
-MovingObstacle = namedtuple("MovingObstacle", "name shape waypoints speed mode key")
+#: A kinematic body that follows waypoints [(x, y) m] at speed [m/s]; mode "loop" or "ping_pong";
+#: yielding in [0, 1]: how much it gives way to bodies within personal_radius [m] of its outline
+#: (0: a blind waypoint follower).
+MovingObstacle = namedtuple("MovingObstacle", "name shape waypoints speed mode yielding personal_radius key")
 #: Standard deviations of sensor noise: laser_range [m], odom_linear [m/s], odom_angular [rad/s].
 Noise = namedtuple("Noise", "laser_range odom_linear odom_angular")
 #: Faults of a robot (mbot_msgs/SetFault): laser_dropout [0, 1], sensor_latency [s],
@@ -187,7 +189,7 @@ def load_world(path):
 
     moving_obstacles = []
     for i, mr in enumerate(r.children("moving_obstacles", required=False)):
-        mr.check_keys(["name", "shape", "size", "radius", "waypoints", "speed", "mode"],
+        mr.check_keys(["name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius"],
                       required=["shape", "waypoints", "speed"])
         name = _name(mr, "name") if "name" in mr else "moving_obstacle_%d" % i
         claim(mr, name)
@@ -207,7 +209,11 @@ def load_world(path):
             mode = _text(mr, "mode", "loop or ping_pong")
             if mode not in ("loop", "ping_pong"):
                 mr.expected("mode", "loop or ping_pong", mr.data["mode"])
-        moving_obstacles.append(MovingObstacle(name, shape, waypoints, speed, mode, "moving_obstacles[%d]" % i))
+        yielding = mr.optional("yielding", float, 1.0, what="a number in [0, 1] (0: it does not give way)",
+                               check=lambda v: 0.0 <= v <= 1.0)
+        personal_radius = mr.optional("personal_radius", float, 0.8, what="a number > 0 [m]", check=lambda v: v > 0.0)
+        moving_obstacles.append(MovingObstacle(name, shape, waypoints, speed, mode, yielding, personal_radius,
+                                               "moving_obstacles[%d]" % i))
 
     nr = r.child("noise", required=False)
     nr.check_keys(["laser_range", "odom_linear", "odom_angular"])

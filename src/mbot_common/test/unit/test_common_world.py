@@ -32,6 +32,8 @@ def test_reads_every_key():
     assert (person.name, person.mode, person.speed) == ("person_1", "ping_pong", 0.6)
     assert person.waypoints == [(2.0, 6.0), (8.0, 6.0), (8.0, 7.0)]
     assert (cart.name, cart.mode, cart.shape.type) == ("moving_obstacle_1", "loop", "box")
+    assert (person.yielding, person.personal_radius) == (0.5, 1.2)
+    assert (cart.yielding, cart.personal_radius) == (1.0, 0.8)  # the defaults
     assert tuple(w.noise) == (0.01, 0.02, 0.03)
     assert len(w.faults) == 1 and w.faults[0].robot == "follower_1"
     assert w.faults[0].faults == Faults(0.1, 0.05, 0.01, 0.02, False, True)

@@ -8,7 +8,7 @@
 
 #include "mbot_sim/world.h"
 
-#include <geometry_msgs/Pose2D.h>
+#include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <mbot_msgs/RemoveObstacle.h>
@@ -119,7 +119,7 @@ private:
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg);
   void onHeartbeat(const std_msgs::Header::ConstPtr& msg);
   bool localizationCurrent(const RobotIo& io) const;
-  void onCmdPose(int robot, const geometry_msgs::Pose2D::ConstPtr& msg);
+  void onCmdPose(int robot, const geometry_msgs::Pose::ConstPtr& msg);
   bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onPause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onUnpause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);

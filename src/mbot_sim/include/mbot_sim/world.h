@@ -7,7 +7,8 @@
  * One World owns sim time: step() advances it by the fixed physics step. Sensors keep their
  * own update timers in sim time (flatland's UpdateTimer idea): after a step, every sensor that
  * is due measures, and the sample (stamped with the sim time of the measurement) goes to the
- * SensorListener, at once or, with a latency fault, a little later.
+ * SensorListener, at once or, with a latency fault, a little later (odometry, joint states and
+ * scans; ground truth is an oracle and always comes at once).
  *
  * Use:
  * @code
@@ -91,7 +92,8 @@ struct JointStateSample
 struct ScanSample
 {
   double stamp = 0.0;         ///< [s]
-  std::vector<float> ranges;  ///< [m]; +Inf: no return within range_max, -Inf: closer than range_min
+  std::vector<float> ranges;  ///< [m]; +Inf: no return within range_max, -Inf: closer than range_min,
+                              ///< NaN: no measurement (laser_dropout)
 };
 
 /// @brief Two bodies started touching.
@@ -183,7 +185,8 @@ public:
   /// @throws SimError: unknown robot, a value out of range
   void setFaults(const std::string& name, const FaultConfig& faults);
   /// @brief Every robot back to its start pose at rest with its odometry at identity; moving
-  ///        obstacles back to their first waypoint. Sim time goes on.
+  ///        obstacles back to their first waypoint. Samples still held back by a latency fault
+  ///        are dropped (they were measured before the reset). Sim time goes on.
   void resetPositions();
 
   // ---- time --------------------------------------------------------------------------------
