@@ -362,13 +362,15 @@ bool traverse(const float* weight, const uint8_t* costs, unsigned size_x, uint32
 }
 }  // namespace
 
-double AStarPlanner::lineCost(const uint8_t* costs, uint32_t a, uint32_t b) const
+double AStarPlanner::lineCost(const uint8_t* costs, uint32_t a, uint32_t b, double& cell_sum) const
 {
   double sum = 0.0;  // sum of weight * scaled length
+  cell_sum = 0.0;    // map costs of the cells after a
   int64_t T = 1;
   const bool ok = traverse(weight_, costs, size_x_, a, b, T,
-                           [&sum](uint32_t, float w, int64_t t0, int64_t t1) {
+                           [&sum, &cell_sum, costs, a](uint32_t cell, float w, int64_t t0, int64_t t1) {
                              sum += static_cast<double>(w) * static_cast<double>(t1 - t0);
+                             if (cell != a) cell_sum += costs[cell];
                            });
   if (!ok) return -1.0;
   const double dx = static_cast<double>(a % size_x_) - static_cast<double>(b % size_x_);
@@ -378,8 +380,13 @@ double AStarPlanner::lineCost(const uint8_t* costs, uint32_t a, uint32_t b) cons
 
 bool AStarPlanner::shortcutOk(const uint8_t* costs, size_t i, size_t j) const
 {
-  const double line = lineCost(costs, dense_[i], dense_[j]);
-  return line >= 0.0 && line <= (cum_[j] - cum_[i]) * (1.0 + config_.smoothing_tolerance) + 1e-6;
+  double cell_sum = 0.0;
+  const double line = lineCost(costs, dense_[i], dense_[j], cell_sum);
+  // Cost-aware line of sight: passable, within the tolerance of the planner's cost, and no dearer
+  // in map costs than the cells it replaces (the planner's cost alone would let a shorter segment
+  // cut through the inflation zone, which is what makes a path brush the walls).
+  return line >= 0.0 && line <= (cum_[j] - cum_[i]) * (1.0 + config_.smoothing_tolerance) + 1e-6 &&
+         cell_sum <= cell_cum_[j] - cell_cum_[i];
 }
 
 void AStarPlanner::greedyPass(const uint8_t* costs)
@@ -424,8 +431,10 @@ void AStarPlanner::rasterize(const uint8_t* costs)
   // The cells the polyline through the picked cells passes, with the cost from the start.
   next_dense_.clear();
   next_cum_.clear();
+  next_cell_cum_.clear();
   next_dense_.push_back(dense_[pick_[0]]);
   next_cum_.push_back(0.0);
+  next_cell_cum_.push_back(0.0);
   for (size_t k = 1; k < pick_.size(); ++k)
   {
     const uint32_t a = dense_[pick_[k - 1]], b = dense_[pick_[k]];
@@ -433,7 +442,7 @@ void AStarPlanner::rasterize(const uint8_t* costs)
     const double dy = static_cast<double>(a / size_x_) - static_cast<double>(b / size_x_);
     const double length = std::sqrt(dx * dx + dy * dy);
     int64_t T = 1;
-    double c = next_cum_.back();
+    double c = next_cum_.back(), cells = next_cell_cum_.back();
     bool first = true;
     traverse(weight_, costs, size_x_, a, b, T, [&](uint32_t cell, float w, int64_t t0, int64_t t1) {
       // Cost of a cell = its weight times the length inside it, counted when it is entered.
@@ -443,12 +452,15 @@ void AStarPlanner::rasterize(const uint8_t* costs)
         first = false;  // cell a is already in the list
         return;
       }
+      cells += costs[cell];
       next_dense_.push_back(cell);
       next_cum_.push_back(c);
+      next_cell_cum_.push_back(cells);
     });
   }
   dense_.swap(next_dense_);
   cum_.swap(next_cum_);
+  cell_cum_.swap(next_cell_cum_);
 }
 
 double AStarPlanner::polylineLength(const std::vector<uint32_t>& cells) const
@@ -467,7 +479,12 @@ void AStarPlanner::smooth(const uint8_t* costs)
 {
   dense_.assign(grid_path_.begin(), grid_path_.end());
   cum_.resize(grid_path_.size());
-  for (size_t i = 0; i < grid_path_.size(); ++i) cum_[i] = costTo(grid_path_[i]);
+  cell_cum_.resize(grid_path_.size());
+  for (size_t i = 0; i < grid_path_.size(); ++i)
+  {
+    cum_[i] = costTo(grid_path_[i]);
+    cell_cum_[i] = i == 0 ? 0.0 : cell_cum_[i - 1] + costs[grid_path_[i]];
+  }
   vertices_ = grid_path_;
   double best = stats_.grid_path_length;
   // Each pass pulls the string tighter: the next pass may pick cells along the previous pass's

@@ -1,16 +1,20 @@
 /**
  * @file dwa_bench.cpp
- * @brief DWA cycle time at default sampling on a typical local costmap (scripts/bench nav).
+ * @brief DWA cycle time at default or shipped sampling on a typical local costmap (scripts/bench nav).
  *
  * A 4 x 4 m local costmap at 0.05 m (80 x 80 cells) around the robot, with a wall, a box and a
  * post inflated by the InflationLayer (radius 0.55 m), and a global plan through it. The robot
  * drives at 0.3 m/s; its pose is jittered a little every cycle so that no two cycles are alike.
  * 100 warm-up cycles, then the measured ones, on one thread.
  *
- * Usage: dwa_bench [--omni] [--cycles N]
+ * Usage: dwa_bench [--omni] [--cycles N] [--config nav_dwa.yaml --description DIR [--model mbot]]
  *   --omni      sample v_y too (dwa_local_planner's defaults: 3 x 10 x 20 samples); without it,
  *               a differential drive (max_vel_y = min_vel_y = 0: 3 x 20 samples)
  *   --cycles N  measured cycles (default 1000)
+ *   --config    the shipped settings instead of dwa_local_planner's defaults, as the nav node
+ *               builds them: the defaults, then the robot model's limits and footprint radius
+ *               (mbot_description package DIR, model mbot unless --model), then the file's
+ *               `DWAPlannerROS` keys (config/nav_dwa.yaml: 6 x 20 samples over 1.5 s)
  * Prints {"p50": ms, "p99": ms, "wall_p50": ms, "wall_p99": ms} on stdout, details on stderr.
  * p50 and p99 are the thread's CPU time per cycle, so that other processes on a shared machine
  * do not count; wall_* are the wall-clock times, for comparison.
@@ -22,11 +26,14 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <time.h>
 
+#include "mbot_common/strict_yaml.h"
+#include "mbot_description/robot_model.h"
 #include "mbot_navigation/dwa_planner.h"
 #include "mbot_navigation/inflation_layer.h"
 
@@ -64,8 +71,65 @@ double percentile(std::vector<double>& values, double q)
 
 int usage(const char* msg)
 {
-  std::cerr << "dwa_bench: " << msg << "\nusage: dwa_bench [--omni] [--cycles N]\n";
+  std::cerr << "dwa_bench: " << msg
+            << "\nusage: dwa_bench [--omni] [--cycles N] [--config nav_dwa.yaml --description DIR [--model mbot]]\n";
   return 2;
+}
+
+/**
+ * The DWA settings the nav node would use with this config file (nav_node.cpp, readDwaConfig):
+ * dwa_local_planner's defaults, the robot model's limits, then the `DWAPlannerROS` keys.
+ */
+DwaConfig shippedConfig(const std::string& path, const std::string& description_dir, const std::string& model_name)
+{
+  const mbot_description::RobotModel model = mbot_description::loadRobotModel(description_dir, model_name);
+  DwaConfig c;
+  const mbot_description::Limits& lim = model.limits;
+  c.max_vel_x = lim.max_vel_x;
+  c.min_vel_x = lim.min_vel_x;
+  c.max_vel_y = lim.max_vel_y;
+  c.min_vel_y = -lim.max_vel_y;
+  c.max_vel_trans = std::max(lim.max_vel_x, lim.max_vel_y);
+  c.max_vel_theta = lim.max_vel_theta;
+  c.min_vel_theta = std::min(c.min_vel_theta, lim.max_vel_theta);
+  c.acc_lim_x = lim.acc_lim_x;
+  c.acc_lim_y = lim.acc_lim_y;
+  c.acc_lim_theta = lim.acc_lim_theta;
+  c.footprint_radius = model.footprint_radius;
+
+  const mbot_common::StrictYaml<> yaml(path);
+  const YAML::Node dwa = yaml.load()["DWAPlannerROS"];
+  if (!dwa) yaml.fail("DWAPlannerROS", "missing (the bench reads the keys from there)");
+  const std::vector<std::pair<const char*, double*>> numbers = {
+      {"max_vel_trans", &c.max_vel_trans}, {"min_vel_trans", &c.min_vel_trans}, {"max_vel_x", &c.max_vel_x},
+      {"min_vel_x", &c.min_vel_x}, {"max_vel_y", &c.max_vel_y}, {"min_vel_y", &c.min_vel_y},
+      {"max_vel_theta", &c.max_vel_theta}, {"min_vel_theta", &c.min_vel_theta}, {"acc_lim_x", &c.acc_lim_x},
+      {"acc_lim_y", &c.acc_lim_y}, {"acc_lim_theta", &c.acc_lim_theta}, {"trans_stopped_vel", &c.trans_stopped_vel},
+      {"theta_stopped_vel", &c.theta_stopped_vel}, {"xy_goal_tolerance", &c.xy_goal_tolerance},
+      {"yaw_goal_tolerance", &c.yaw_goal_tolerance}, {"sim_time", &c.sim_time},
+      {"sim_granularity", &c.sim_granularity}, {"angular_sim_granularity", &c.angular_sim_granularity},
+      {"path_distance_bias", &c.path_distance_bias}, {"goal_distance_bias", &c.goal_distance_bias},
+      {"occdist_scale", &c.occdist_scale}, {"twirling_scale", &c.twirling_scale},
+      {"forward_point_distance", &c.forward_point_distance}, {"oscillation_reset_dist", &c.oscillation_reset_dist},
+      {"oscillation_reset_angle", &c.oscillation_reset_angle}};
+  const std::vector<std::pair<const char*, int*>> integers = {
+      {"vx_samples", &c.vx_samples}, {"vy_samples", &c.vy_samples}, {"vth_samples", &c.vth_samples}};
+  const std::vector<std::pair<const char*, bool*>> flags = {{"latch_xy_goal_tolerance", &c.latch_xy_goal_tolerance},
+                                                            {"prune_plan", &c.prune_plan}};
+  std::vector<std::string> known;
+  for (const auto& k : numbers) known.push_back(k.first);
+  for (const auto& k : integers) known.push_back(k.first);
+  for (const auto& k : flags) known.push_back(k.first);
+  yaml.checkKeys(dwa, "DWAPlannerROS", known);
+  const std::string where = "DWAPlannerROS.";
+  for (const auto& k : numbers)
+    if (dwa[k.first]) *k.second = yaml.number(dwa[k.first], where + k.first);
+  for (const auto& k : integers)
+    if (dwa[k.first]) *k.second = static_cast<int>(yaml.integer(dwa[k.first], where + k.first));
+  for (const auto& k : flags)
+    if (dwa[k.first]) *k.second = yaml.boolean(dwa[k.first], where + k.first);
+  c.validate();
+  return c;
 }
 }  // namespace
 
@@ -73,11 +137,18 @@ int main(int argc, char** argv)
 {
   bool omni = false;
   int cycles = 1000;
+  std::string config_path, description_dir, model_name = "mbot";
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
     if (arg == "--omni")
       omni = true;
+    else if (arg == "--config" && i + 1 < argc)
+      config_path = argv[++i];
+    else if (arg == "--description" && i + 1 < argc)
+      description_dir = argv[++i];
+    else if (arg == "--model" && i + 1 < argc)
+      model_name = argv[++i];
     else if (arg == "--cycles" && i + 1 < argc)
     {
       char* end = nullptr;
@@ -108,9 +179,23 @@ int main(int argc, char** argv)
     plan.push_back(Pose2D{x, y, 0.0});
   }
 
+  if (!config_path.empty() && description_dir.empty()) return usage("--config needs --description DIR");
   DwaConfig config;  // dwa_local_planner's defaults
   config.footprint_radius = 0.15;
-  if (!omni)
+  if (!config_path.empty())
+  {
+    try
+    {
+      config = shippedConfig(config_path, description_dir, model_name);
+    }
+    catch (const std::exception& e)
+    {
+      std::cerr << "dwa_bench: " << e.what() << "\n";
+      return 2;
+    }
+    omni = config.max_vel_y != config.min_vel_y;
+  }
+  else if (!omni)
   {
     config.max_vel_y = 0.0;
     config.min_vel_y = 0.0;
@@ -144,8 +229,8 @@ int main(int argc, char** argv)
     samples += result.samples;
   }
 
-  std::fprintf(stderr, "dwa_bench: %s, %d cycles, %.1f trajectories per cycle, %d failed cycles\n",
-               omni ? "omni" : "diff drive", cycles, static_cast<double>(samples) / cycles, failures);
+  std::fprintf(stderr, "dwa_bench: %s%s, %d cycles, %.1f trajectories per cycle, %d failed cycles\n",
+               omni ? "omni" : "diff drive", config_path.empty() ? "" : (", " + config_path).c_str(), cycles, static_cast<double>(samples) / cycles, failures);
   std::printf("{\"p50\": %.4f, \"p99\": %.4f, \"wall_p50\": %.4f, \"wall_p99\": %.4f}\n",
               percentile(times_ms, 0.50), percentile(times_ms, 0.99), percentile(wall_ms, 0.50),
               percentile(wall_ms, 0.99));

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <queue>
 #include <random>
@@ -10,6 +11,8 @@
 #include <vector>
 
 #include "mbot_navigation/astar_planner.h"
+#include "mbot_navigation/inflation_layer.h"
+#include "mbot_navigation/path_cost.h"
 #include "mbot_navigation/planner_factory.h"
 
 using namespace mbot_navigation;
@@ -35,11 +38,14 @@ double lengthCells(const PlanResult& r)
   return len / kRes;
 }
 
-/// Reference: plain Dijkstra with the planner's cost model; returns the optimal cost (or -1).
-double referenceCost(const Costmap2D& m, int sx, int sy, int gx, int gy, double neutral, double factor)
+/// Reference: plain Dijkstra with the planner's cost model; returns the optimal cost (or -1) and,
+/// when `path` is given, the cells of the optimal path from start to goal.
+double referenceCost(const Costmap2D& m, int sx, int sy, int gx, int gy, double neutral, double factor,
+                     std::vector<int>* path = nullptr)
 {
   const int W = m.sizeX(), H = m.sizeY();
   std::vector<double> dist(W * H, 1e300);
+  std::vector<int> parent(W * H, -1);
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
   dist[sy * W + sx] = 0.0;
@@ -49,7 +55,16 @@ double referenceCost(const Costmap2D& m, int sx, int sy, int gx, int gy, double 
     auto [d, i] = pq.top();
     pq.pop();
     if (d > dist[i]) continue;
-    if (i == gy * W + gx) return d;
+    if (i == gy * W + gx)
+    {
+      if (path)
+      {
+        path->clear();
+        for (int c = i; c != -1; c = parent[c]) path->push_back(c);
+        std::reverse(path->begin(), path->end());
+      }
+      return d;
+    }
     const int x = i % W, y = i / W;
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx)
@@ -65,6 +80,7 @@ double referenceCost(const Costmap2D& m, int sx, int sy, int gx, int gy, double 
         if (nd < dist[ny * W + nx])
         {
           dist[ny * W + nx] = nd;
+          parent[ny * W + nx] = i;
           pq.push({nd, ny * W + nx});
         }
       }
@@ -95,6 +111,50 @@ AStarConfig gridOnly()
   c.smooth_path = false;
   c.heuristic_weight = 1.0;
   return c;
+}
+
+/**
+ * A fixture like the benchmark maps (bench/inputs/README.md), small enough for a brute-force
+ * reference: 300 x 300 cells with a lethal border and seeded random lethal rectangles (8..60
+ * cells a side, as there, ~15 % of the map), inflated as costmap_2d does (inscribed 0.15 m, inflation 0.55 m,
+ * cost scaling 10) by InflationLayer.
+ */
+Costmap2D benchLikeMap(unsigned seed)
+{
+  const int N = 300;
+  Costmap2D m(N, N, kRes, 0.0, 0.0);
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> side(8, 60), pos(1, N - 2);
+  for (int i = 0; i < N; ++i)
+  {
+    m.setCost(i, 0, cost::LETHAL);
+    m.setCost(i, N - 1, cost::LETHAL);
+    m.setCost(0, i, cost::LETHAL);
+    m.setCost(N - 1, i, cost::LETHAL);
+  }
+  for (int lethal = 0; lethal < N * N * 15 / 100;)
+  {
+    const int x0 = pos(rng), y0 = pos(rng), w = side(rng), h = side(rng);
+    for (int y = y0; y < std::min(N - 1, y0 + h); ++y)
+      for (int x = x0; x < std::min(N - 1, x0 + w); ++x)
+        if (m.cost(x, y) != cost::LETHAL)
+        {
+          m.setCost(x, y, cost::LETHAL);
+          ++lethal;
+        }
+  }
+  InflationLayer inflation;  // defaults: 0.55 m, 10 /m
+  inflation.onFootprintChanged(0.15);
+  inflation.inflate(m);
+  return m;
+}
+
+/// The poses through the centres of `cells` (as a planner returns them, ends at the centres).
+std::vector<Pose2D> posesThrough(const Costmap2D& m, const std::vector<int>& cells)
+{
+  std::vector<Pose2D> poses;
+  for (int c : cells) poses.push_back(at(m, c % m.sizeX(), c / m.sizeX()));
+  return poses;
 }
 
 /// 40 x 40 free grid with a vertical wall at x = 20 except a gap at y = 32..33.
@@ -395,6 +455,50 @@ TEST(AStar, SmoothingKeepsClearOfInflatedCellsItMayNotCross)
   const PlanResult r = planner.makePlan(m, at(m, 5, 15), at(m, 35, 25));
   expectValidPath(m, r);
   EXPECT_LE(lengthCells(r), planner.lastStats().grid_path_length + 1e-9);
+}
+
+TEST(AStar, PathCostWithinAQuarterOfNavfnDijkstraOnBenchLikeMaps)
+{
+  // The default settings (those of config/nav_move_base.yaml) against a brute-force Dijkstra with
+  // navfn's cost model (neutral 50, factor 0.8: move_base's default planner), on random pairs of
+  // far-apart free cells: the mean path cost (map costs of the cells the path passes,
+  // path_cost.h) is at most 1.25 times the reference's. Every shortcut of the smoothing keeps the
+  // cost at or below the grid path's, and the smoothed path is shorter.
+  AStarPlanner planner;
+  double planned_cost = 0.0, reference_cost = 0.0, planned_len = 0.0, grid_len = 0.0;
+  int pairs = 0;
+  for (unsigned seed : {1u, 2u, 3u})
+  {
+    const Costmap2D m = benchLikeMap(seed);
+    std::mt19937 rng(100 + seed);
+    std::uniform_int_distribution<int> pos(1, 298);
+    for (int k = 0; k < 15;)
+    {
+      const int sx = pos(rng), sy = pos(rng), gx = pos(rng), gy = pos(rng);
+      if (m.cost(sx, sy) >= cost::INSCRIBED || m.cost(gx, gy) >= cost::INSCRIBED || std::hypot(gx - sx, gy - sy) < 150)
+        continue;
+      std::vector<int> reference;
+      if (referenceCost(m, sx, sy, gx, gy, 50.0, 0.8, &reference) < 0.0) continue;
+      ++k;
+      const PlanResult r = planner.makePlan(m, at(m, sx, sy), at(m, gx, gy));
+      expectValidPath(m, r);
+      const double cost = pathCellCost(m, r.path);
+      const std::vector<uint32_t>& grid = planner.lastGridPath();
+      const double grid_cost = pathCellCost(m, posesThrough(m, std::vector<int>(grid.begin(), grid.end())));
+      EXPECT_LE(cost, grid_cost + 1e-9) << "seed " << seed << " pair " << k;
+      planned_cost += cost;
+      reference_cost += pathCellCost(m, posesThrough(m, reference));
+      planned_len += lengthCells(r);
+      grid_len += planner.lastStats().grid_path_length;
+      ++pairs;
+    }
+  }
+  ASSERT_EQ(pairs, 45);
+  EXPECT_GT(reference_cost, 0.0);  // the pairs do pass inflated cells
+  EXPECT_LE(planned_cost, 1.25 * reference_cost) << "mean " << planned_cost / pairs << " vs " << reference_cost / pairs;
+  EXPECT_LT(planned_len, grid_len);
+  std::printf("mean path cost %.1f (navfn-model Dijkstra %.1f), mean length %.1f cells (grid path %.1f)\n",
+              planned_cost / pairs, reference_cost / pairs, planned_len / pairs, grid_len / pairs);
 }
 
 TEST(PlannerFactory, MakesAStarAndRejectsUnknownNames)

@@ -11,18 +11,26 @@
  * Heuristic: the octile distance times neutral_cost, the least any step can cost, so it never
  * overestimates (admissible and consistent) and heuristic_weight = 1 gives the optimal grid
  * path. heuristic_weight w > 1 is weighted A*: far fewer cells searched, path cost at most w times
- * the optimum. On the shared benchmark maps (plan_bench, 1000^2 and 2000^2) the default w = 1.2
- * searches about 3 (1000^2) to 7 (2000^2) times fewer cells than w = 1, at p50 and p95, for a
- * mean smoothed path 0.2-0.6 % longer; w = 1.1 searches 1.6-2.4 times more cells in the slowest
- * 5 % of queries for ~0.5 % shorter paths on the 2000 x 2000 map, and w >= 1.25 makes the route
- * choices there ~1 % longer. (These figures depend on the open list's first-in first-out order
- * within a bucket, see OpenList: last-in first-out made w = 1.2 paths ~0.5 % longer.)
+ * the optimum. That bound is loose where it matters: w's slack goes into the cheapest thing to
+ * give up, clearance, so a weighted path hugs the inflation zone unless cells near obstacles are
+ * dear. With global_planner's cost_factor 3 they are: on the shared benchmark maps (plan_bench,
+ * 1000^2 and 2000^2) w = 1.2 keeps the mean path cost (map costs of the cells the path passes)
+ * at 64 and 159, against 54 and 90 for w = 1 and 518 and 1317 for w = 1.5, while it searches 3.5
+ * (1000^2) to 6 (2000^2) times fewer cells than w = 1 at p95. With navfn's cost_factor 0.8 the
+ * same w = 1.2 paths cost 806 and 1970 (w = 1: 184 and 339). (These figures depend on the open
+ * list's first-in first-out order within a bucket, see OpenList.)
  *
- * Smoothing (string pulling): from each kept vertex the path jumps to the farthest later cell it
- * can reach in a straight line whose cells (every cell the segment touches) are all passable and
- * whose cost integral is at most (1 + smoothing_tolerance) times that of the path it replaces.
- * The next pass runs again over the cells of the previous pass's polyline, which pulls each
- * vertex toward the obstacle corner that holds it. The result is never longer than the grid path.
+ * Smoothing (string pulling, a cost-aware line of sight): from each kept vertex the path jumps to
+ * the farthest later cell it can reach in a straight line whose cells (every cell the segment
+ * touches) are all passable, whose cost integral is at most (1 + smoothing_tolerance) times that
+ * of the path it replaces, and whose cells' map costs add up to no more than those of the cells
+ * it replaces. The last condition keeps shortcuts out of the inflation zone: the planner's cost
+ * alone trades clearance for length (50 + 3 c per cell), so a shortcut through cells of cost 100
+ * could still "pay", and the path would brush the walls (plan_bench, w = 1.2, tolerance 0: mean
+ * path cost 2877 and 6764 with cost_factor 0.8 and without this rule, 62 and 150 with both).
+ * A later pass runs again over the cells of the previous pass's polyline, pulling each vertex
+ * toward the obstacle corner that holds it; on the bench maps that shortens the path by only
+ * 0.1 %, so the default is one pass. The result is never longer than the grid path.
  *
  * Speed: one 8-byte record per cell (Node: generation stamp + parent step, and g), sized once per
  * map size; the stamp says whether g belongs to the current query, so nothing is cleared between
@@ -53,9 +61,9 @@ struct AStarConfig
   /// Cost of a 1-cell step over a free cell [cost units] (global_planner ~neutral_cost).
   double neutral_cost = 50.0;
   /// Weight of a cell's cost value in a step [cost units per cost value] (global_planner
-  /// ~cost_factor, default 3.0 there; 0.8 is navfn's COST_FACTOR: with 3.0 paths keep further
-  /// from obstacles but are ~0.6 % longer and 3-7 % more cells are searched on the bench maps).
-  double cost_factor = 0.8;
+  /// ~cost_factor, 3.0 as there; navfn's COST_FACTOR 0.8 lets weighted A* hug the inflation zone,
+  /// see the file comment).
+  double cost_factor = 3.0;
   /// NO_INFORMATION cells are passable, at cost value 255 (global_planner ~allow_unknown).
   bool allow_unknown = true;
   /// >= 1: 1 = optimal A*, more = weighted A* (fewer cells searched, longer paths; see the file
@@ -63,10 +71,11 @@ struct AStarConfig
   double heuristic_weight = 1.2;
   /// Shorten the grid path by line-of-sight string pulling.
   bool smooth_path = true;
-  /// A shortcut may cost this fraction more than the path piece it replaces [-].
-  double smoothing_tolerance = 0.5;
+  /// A shortcut may cost this fraction more than the path piece it replaces, in the planner's
+  /// cost [-] (its cells' map costs may never add up to more).
+  double smoothing_tolerance = 0.0;
   /// String-pulling passes; each tightens the previous one (>= 1).
-  int smoothing_passes = 3;
+  int smoothing_passes = 1;
 };
 
 /// @brief Figures about the last makePlan() call (for benches and tests).
@@ -134,9 +143,10 @@ private:
   double polylineLength(const std::vector<uint32_t>& cells) const;
   /**
    * @brief Walk the cells that the segment between the centres of cells a and b touches.
+   * @param cell_sum the sum of the map costs of the cells it passes through, a's excepted
    * @return the segment's cost integral [cost units], or a negative value when a cell is impassable
    */
-  double lineCost(const uint8_t* costs, uint32_t a, uint32_t b) const;
+  double lineCost(const uint8_t* costs, uint32_t a, uint32_t b, double& cell_sum) const;
 
   AStarConfig config_;
   float weight_[256];       ///< neutral_cost + cost_factor * c per cost value; +inf if impassable
@@ -215,10 +225,12 @@ private:
   OpenList open_;
   std::vector<uint32_t> grid_path_;
   std::vector<uint32_t> vertices_;
-  // Smoothing buffers (reused): the current path as the cells it passes and the cost from the
-  // start to each [cost units], the cells a pass picks, and the next pass's path.
+  // Smoothing buffers (reused): the current path as the cells it passes, the cost from the start
+  // to each [cost units] and the sum of the map costs of the cells up to each, the cells a pass
+  // picks, and the next pass's path.
   std::vector<uint32_t> dense_, next_dense_;
   std::vector<double> cum_, next_cum_;
+  std::vector<double> cell_cum_, next_cell_cum_;
   std::vector<size_t> pick_;
   std::vector<uint32_t> candidate_;
   AStarStats stats_;
