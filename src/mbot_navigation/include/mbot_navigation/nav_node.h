@@ -26,7 +26,8 @@
  * move_base_params.h, which also takes move_base's standard keys and planner names):
  *   robot (the namespace), model (mbot): the robot model (mbot_description) that gives the
  *     footprint radius and the velocity and acceleration limits;
- *   base_global_planner ("astar" | "ompl"), base_local_planner ("dwa");
+ *   base_global_planner ("astar" | "ompl"; navfn/NavfnROS and global_planner/GlobalPlanner run
+ *   the A*), base_local_planner ("dwa" | dwa_local_planner/DWAPlannerROS);
  *   controller_frequency [Hz] 20, planner_frequency [Hz] 0, planner_patience [s] 5,
  *   controller_patience [s] 15, oscillation_timeout [s] 0, oscillation_distance [m] 0.5,
  *   recovery_behavior_enabled (true), clearing_rotation_allowed (true), back_up_distance [m] 0.3,
@@ -41,7 +42,8 @@
  *     robot model's);
  *   GlobalPlanner/<key>: the A* settings (astar_planner.h AStarConfig, global_planner's names);
  *   OmplPlanner/<key>: the OMPL planner's (ompl_planner.h OmplConfig).
- * Unknown keys and wrong types stop the node with a message naming the parameter.
+ * Unknown keys and wrong types stop the node with a message naming the parameter; a standard
+ * move_base key that this node does not implement is one warning (docs/move_base_keys.md).
  */
 #pragma once
 
