@@ -49,9 +49,12 @@ def dynparam(*args):
 
 
 class Reconfigure(unittest.TestCase):
+    def setUp(self):
+        self.client = action_client(ROBOT)  # waits (wall time) until the nav node is up
+
     def test_max_vel_x_takes_effect_while_driving(self):
         speeds = Speeds()
-        client = action_client(ROBOT)
+        client = self.client
         # Across the office: long straight stretches in the corridors.
         client.send_goal(make_goal(-5.0, 7.5, 0.0))
         wait_until(lambda: speeds.latest() > 0.4, 60.0, "the robot to drive faster than 0.4 m/s")
@@ -61,6 +64,8 @@ class Reconfigure(unittest.TestCase):
         self.assertAlmostEqual(rospy.get_param("/%s/move_base/DWAPlannerROS/max_vel_x" % ROBOT), NEW_MAX)
         wait_until(lambda: rospy.Time.now().to_sec() > changed + 20.0 or client.get_state() not in
                    (GoalStatus.PENDING, GoalStatus.ACTIVE), 30.0, "20 sim s of driving")
+        self.assertEqual(client.get_state(), GoalStatus.ACTIVE, "the goal ended early: %s: %s"
+                         % (state_name(client.get_state()), client.get_goal_status_text()))
         after_max = speeds.max_between(changed + SETTLE, rospy.Time.now().to_sec())
         rospy.loginfo("max speed %.3f m/s before the change, %.3f m/s from %.1f s after it", before_max, after_max,
                       SETTLE)
@@ -74,7 +79,7 @@ class Reconfigure(unittest.TestCase):
         grids = []
         rospy.Subscriber("/%s/move_base/global_costmap/costmap" % ROBOT, OccupancyGrid,
                          lambda m: grids.append(m), queue_size=1)
-        wait_until(lambda: grids, 30.0, "a global costmap")
+        wait_until(lambda: grids, 60.0, "a global costmap")
         inflated = lambda g: sum(1 for v in g.data if 0 < v < 99)  # noqa: E731
         before = inflated(grids[-1])
         dynparam("set", "/%s/move_base/global_costmap/inflation_layer" % ROBOT, "inflation_radius", "0.3")

@@ -38,7 +38,7 @@
  *   (the costmaps' robots_padding draws them bigger than their footprint);
  *   global_costmap/..., local_costmap/... (costmap_ros.h);
  *   DWAPlannerROS/<key> or <key> (flat) for the DWA settings, with dwa_local_planner's names
- *     (trajectory.h DwaConfig; setting one key in both places is an error; limits default to the
+ *     (trajectory.h DwaConfig; a key set in both places must agree; limits default to the
  *     robot model's);
  *   GlobalPlanner/<key>: the A* settings (astar_planner.h AStarConfig, global_planner's names);
  *   OmplPlanner/<key>: the OMPL planner's (ompl_planner.h OmplConfig).
