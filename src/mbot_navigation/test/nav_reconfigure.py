@@ -42,7 +42,7 @@ class Speeds(object):
 
 def dynparam(*args):
     out = subprocess.run(["rosrun", "dynamic_reconfigure", "dynparam"] + list(args), stdout=subprocess.PIPE,
-                         stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
+                         stderr=subprocess.STDOUT, universal_newlines=True, timeout=240)
     if out.returncode != 0:
         raise AssertionError("dynparam %s: exit %d: %s" % (" ".join(args), out.returncode, out.stdout))
     return out.stdout
