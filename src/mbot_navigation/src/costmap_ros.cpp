@@ -2,26 +2,233 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <tf2/exceptions.h>
 #include <tf2/utils.h>
 
 #include <mbot_common/ros_edge.h>
+#include "mbot_navigation/move_base_params.h"
 
 namespace mbot_navigation
 {
 using mbot_common::StrictParams;
 
-CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& d)
+namespace
 {
+std::string stripSlash(std::string frame)
+{
+  // costmap_2d (noetic) drops a leading '/' (tf1 style, as in older tutorials); tf2 rejects it.
+  while (!frame.empty() && frame.front() == '/') frame.erase(0, 1);
+  return frame;
+}
+
+// costmap_2d keys this node does not implement, by where they appear.
+const std::vector<std::string> kIgnoredCostmapKeys = {"always_send_full_costmap"};
+const std::vector<std::string> kIgnoredStaticKeys = {"first_map_only", "subscribe_to_updates", "use_maximum"};
+const std::vector<std::string> kIgnoredObstacleKeys = {
+    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z",      "z_resolution",
+    "z_voxels",            "unknown_threshold",   "mark_threshold",     "publish_voxel_map"};
+const std::vector<std::string> kIgnoredSourceKeys = {"sensor_frame",        "observation_persistence",
+                                                     "expected_update_rate", "min_obstacle_height",
+                                                     "max_obstacle_height", "inf_is_valid"};
+// Flat layer keys: with `plugins`, costmap_2d reads them from the layers' namespaces instead.
+const std::vector<std::string> kFlatLayerKeys = {
+    "static_map",       "map_type",          "map_topic",          "lethal_cost_threshold", "unknown_cost_value",
+    "trinary_costmap",  "first_map_only",    "subscribe_to_updates", "use_maximum",       "scan_topic",
+    "observation_sources", "obstacle_range", "raytrace_range",     "footprint_clearing_enabled",
+    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z",         "z_resolution",
+    "z_voxels",         "unknown_threshold", "mark_threshold",     "publish_voxel_map",     "inflation_radius",
+    "cost_scaling_factor", "inflate_unknown", "robots_layer",      "robots_prediction_time",
+    "robots_prediction_step", "robots_prediction_cost", "robots_padding", "robots_scan_margin"};
+
+/// The static layer's keys of `p` (the costmap's namespace, or the layer's).
+void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
+{
+  s.map_topic = p.getString("map_topic", s.map_topic);
+  s.static_layer.lethal_cost_threshold = p.getInt("lethal_cost_threshold", s.static_layer.lethal_cost_threshold);
+  s.static_layer.unknown_cost_value = p.getInt("unknown_cost_value", s.static_layer.unknown_cost_value);
+  s.static_layer.trinary_costmap = p.getBool("trinary_costmap", s.static_layer.trinary_costmap);
+  ignoreStandardKeys(p, nh, kIgnoredStaticKeys, "a costmap_2d static layer key", w);
+}
+
+/// The obstacle layer's keys: ours (scan_topic) or costmap_2d's observation_sources, of which one
+/// LaserScan source is used (its own obstacle_range / raytrace_range win, as in costmap_2d).
+void readObstacleLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
+{
+  ObstacleLayerConfig& o = s.obstacle_layer;
+  o.obstacle_range = p.getDouble("obstacle_range", o.obstacle_range);
+  o.raytrace_range = p.getDouble("raytrace_range", o.raytrace_range);
+  o.footprint_clearing_enabled = p.getBool("footprint_clearing_enabled", o.footprint_clearing_enabled);
+  ignoreStandardKeys(p, nh, kIgnoredObstacleKeys, "a costmap_2d obstacle layer key", w);
+  const bool has_scan_topic = nh.hasParam("scan_topic");
+  s.scan_topic = p.getString("scan_topic", s.scan_topic);
+  if (!nh.hasParam("observation_sources")) return;
+  if (has_scan_topic)
+    throw std::runtime_error("parameters " + nh.resolveName("scan_topic") + " and " +
+                             nh.resolveName("observation_sources") + ": set one of them");
+  std::istringstream names(p.getString("observation_sources", ""));
+  s.scan_topic.clear();  // no LaserScan source: no obstacle layer
+  std::string name;
+  while (names >> name)
+  {
+    StrictParams sp{ros::NodeHandle(nh, name)};
+    const ros::NodeHandle source_nh(nh, name);
+    p.markKnown(name);
+    const std::string data_type = sp.getString("data_type", "PointCloud");
+    const std::string topic = sp.getString("topic", name);
+    const bool marking = sp.getBool("marking", true), clearing = sp.getBool("clearing", false);
+    const double obstacle_range = sp.getDouble("obstacle_range", o.obstacle_range);
+    const double raytrace_range = sp.getDouble("raytrace_range", o.raytrace_range);
+    ignoreStandardKeys(sp, source_nh, kIgnoredSourceKeys, "a costmap_2d observation source key", w);
+    sp.checkNoUnknown();
+    if (data_type != "LaserScan" && data_type != "PointCloud" && data_type != "PointCloud2")
+      throw std::runtime_error("parameter " + source_nh.resolveName("data_type") +
+                               ": expected LaserScan, PointCloud or PointCloud2, got '" + data_type + "'");
+    if (data_type != "LaserScan")
+      w.push_back("observation source " + source_nh.getNamespace() + ": data_type " + data_type +
+                  " is not implemented (LaserScan only); ignored");
+    else if (!s.scan_topic.empty())
+      w.push_back("observation source " + source_nh.getNamespace() +
+                  ": only one LaserScan source is implemented (" + s.scan_topic + " is used); ignored");
+    else if (!marking && !clearing)
+      w.push_back("observation source " + source_nh.getNamespace() + ": neither marking nor clearing; ignored");
+    else
+    {
+      if (!marking || !clearing)
+        w.push_back("observation source " + source_nh.getNamespace() +
+                    ": marking and clearing are always both done here; '" + (marking ? "clearing" : "marking") +
+                    ": false' is ignored");
+      s.scan_topic = topic;
+      o.obstacle_range = obstacle_range;
+      o.raytrace_range = raytrace_range;
+    }
+  }
+}
+
+void readInflationLayer(StrictParams& p, CostmapRosSettings& s)
+{
+  InflationLayerConfig& c = s.inflation_layer;
+  c.inflation_radius = p.getDouble("inflation_radius", c.inflation_radius);
+  c.cost_scaling_factor = p.getDouble("cost_scaling_factor", c.cost_scaling_factor);
+  c.inflate_unknown = p.getBool("inflate_unknown", c.inflate_unknown);
+}
+
+/// The robots layer (ours): flat keys are robots_<key>, in a plugin's namespace plain <key>.
+void readRobotsLayer(StrictParams& p, const std::string& prefix, CostmapRosSettings& s, int& prediction_cost)
+{
+  s.robots.prediction_time = p.getDouble(prefix + "prediction_time", s.robots.prediction_time);
+  s.robots.prediction_step = p.getDouble(prefix + "prediction_step", s.robots.prediction_step);
+  prediction_cost = p.getInt(prefix + "prediction_cost", prediction_cost);
+  s.robots_padding = p.getDouble(prefix + "padding", s.robots_padding);
+  s.robots_scan_margin = p.getDouble(prefix + "scan_margin", s.robots_scan_margin);
+}
+
+enum class LayerKind
+{
+  STATIC,
+  OBSTACLE,
+  INFLATION,
+  ROBOTS
+};
+
+/// costmap_2d's `plugins` list: [{name, type}, ...] -> the layers, each read from its namespace.
+void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, int& prediction_cost,
+                 ParamWarnings& w)
+{
+  XmlRpc::XmlRpcValue list;
+  nh.getParam("plugins", list);
+  p.markKnown("plugins");
+  const std::string param = nh.resolveName("plugins");
+  if (list.getType() != XmlRpc::XmlRpcValue::TypeArray)
+    throw std::runtime_error("parameter " + param + ": expected a list of {name: ..., type: ...}");
+  static const std::vector<std::pair<std::string, LayerKind>> types = {
+      {"costmap_2d::StaticLayer", LayerKind::STATIC},       {"costmap_2d::ObstacleLayer", LayerKind::OBSTACLE},
+      {"costmap_2d::VoxelLayer", LayerKind::OBSTACLE},      {"costmap_2d::InflationLayer", LayerKind::INFLATION},
+      {"mbot_navigation::RobotsLayer", LayerKind::ROBOTS}};
+  s.static_map = s.robots_layer = s.inflation = false;
+  s.scan_topic.clear();
+  std::vector<LayerKind> seen;
+  for (int i = 0; i < list.size(); ++i)
+  {
+    XmlRpc::XmlRpcValue& entry = list[i];
+    if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct || !entry.hasMember("name") || !entry.hasMember("type") ||
+        entry["name"].getType() != XmlRpc::XmlRpcValue::TypeString ||
+        entry["type"].getType() != XmlRpc::XmlRpcValue::TypeString)
+      throw std::runtime_error("parameter " + param + ": entry " + std::to_string(i) +
+                               " is not {name: <string>, type: <string>}");
+    const std::string name = entry["name"], type = entry["type"];
+    auto it = std::find_if(types.begin(), types.end(), [&](const auto& t) { return t.first == type; });
+    if (it == types.end())
+    {
+      std::string known;
+      for (const auto& t : types) known += (known.empty() ? "" : ", ") + t.first;
+      throw std::runtime_error("parameter " + param + ": layer '" + name + "' has type '" + type +
+                               "', which this node does not have (it has " + known + ")");
+    }
+    if (std::find(seen.begin(), seen.end(), it->second) != seen.end())
+      throw std::runtime_error("parameter " + param + ": layer '" + name + "' (" + type +
+                               "): this node has one layer of each kind");
+    seen.push_back(it->second);
+    const ros::NodeHandle layer_nh(nh, name);
+    StrictParams lp(layer_nh);
+    p.markKnown(name);
+    const bool enabled = lp.getBool("enabled", true);
+    switch (it->second)
+    {
+      case LayerKind::STATIC:
+        s.static_map = enabled;
+        s.static_layer.track_unknown_space = lp.getBool("track_unknown_space", s.costmap.track_unknown_space);
+        readStaticLayer(lp, layer_nh, s, w);
+        break;
+      case LayerKind::OBSTACLE:
+        if (type == "costmap_2d::VoxelLayer")
+          w.push_back("layer " + layer_nh.getNamespace() + ": costmap_2d::VoxelLayer is read as a 2-D obstacle layer");
+        s.obstacle_layer.track_unknown_space = lp.getBool("track_unknown_space", s.costmap.track_unknown_space);
+        if (!layer_nh.hasParam("scan_topic") && !layer_nh.hasParam("observation_sources"))
+          throw std::runtime_error("layer " + layer_nh.getNamespace() + " (" + type +
+                                   "): expected observation_sources (or scan_topic)");
+        readObstacleLayer(lp, layer_nh, s, w);
+        if (!enabled) s.scan_topic.clear();
+        break;
+      case LayerKind::INFLATION:
+        s.inflation = enabled;
+        s.inflation_layer_name = name;
+        readInflationLayer(lp, s);
+        break;
+      case LayerKind::ROBOTS:
+        s.robots_layer = enabled;
+        readRobotsLayer(lp, "", s, prediction_cost);
+        break;
+    }
+    lp.checkNoUnknown();
+  }
+  if (!s.inflation)
+    w.push_back("parameter " + param + ": no inflation layer, so nothing keeps the robot's radius off obstacles");
+  for (const std::string& key : kFlatLayerKeys)
+    if (nh.hasParam(key))
+    {
+      p.markKnown(key);
+      w.push_back("parameter " + nh.resolveName(key) +
+                  ": with `plugins`, layer settings go in the layer's namespace; ignored");
+    }
+}
+}  // namespace
+
+CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& d,
+                                       std::vector<std::string>* warnings)
+{
+  ParamWarnings local_warnings;
+  ParamWarnings& w = warnings ? *warnings : local_warnings;
   StrictParams p(costmap_nh);
   CostmapRosSettings s = d;
-  s.global_frame = p.getString("global_frame", d.global_frame);
-  s.robot_base_frame = p.getString("robot_base_frame", d.robot_base_frame);
+  s.global_frame = stripSlash(p.getString("global_frame", d.global_frame));
+  s.robot_base_frame = stripSlash(p.getString("robot_base_frame", d.robot_base_frame));
   s.update_frequency = p.getDouble("update_frequency", d.update_frequency);
   s.publish_frequency = p.getDouble("publish_frequency", d.publish_frequency);
   s.transform_tolerance = p.getDouble("transform_tolerance", d.transform_tolerance);
+  ignoreStandardKeys(p, costmap_nh, kIgnoredCostmapKeys, "a costmap_2d key", w);
 
   LayeredCostmapConfig& c = s.costmap;
   c.rolling_window = p.getBool("rolling_window", d.costmap.rolling_window);
@@ -31,32 +238,52 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
   c.origin_x = p.getDouble("origin_x", d.costmap.origin_x);
   c.origin_y = p.getDouble("origin_y", d.costmap.origin_y);
   c.robot_radius = p.getDouble("robot_radius", d.costmap.robot_radius);
+  XmlRpc::XmlRpcValue footprint;
+  p.markKnown("footprint");
+  if (costmap_nh.getParam("footprint", footprint))
+  {
+    // As costmap_2d: a footprint wins over robot_radius. The layers here are circular.
+    c.robot_radius = footprintRadius(footprint, costmap_nh.resolveName("footprint"));
+    w.push_back("parameter " + costmap_nh.resolveName("footprint") + ": the footprint polygon is taken as its " +
+                "circumscribed circle, radius " + std::to_string(c.robot_radius) + " m");
+  }
+  c.robot_radius += p.getDouble("footprint_padding", 0.0);
   c.track_unknown_space = p.getBool("track_unknown_space", d.costmap.track_unknown_space);
-
-  s.static_map = p.getBool("static_map", d.static_map);
-  s.map_topic = p.getString("map_topic", d.map_topic);
   s.static_layer.track_unknown_space = c.track_unknown_space;
-  s.static_layer.lethal_cost_threshold = p.getInt("lethal_cost_threshold", d.static_layer.lethal_cost_threshold);
-  s.static_layer.unknown_cost_value = p.getInt("unknown_cost_value", d.static_layer.unknown_cost_value);
-  s.static_layer.trinary_costmap = p.getBool("trinary_costmap", d.static_layer.trinary_costmap);
-
-  s.scan_topic = p.getString("scan_topic", d.scan_topic);
   s.obstacle_layer.track_unknown_space = c.track_unknown_space;
-  s.obstacle_layer.obstacle_range = p.getDouble("obstacle_range", d.obstacle_layer.obstacle_range);
-  s.obstacle_layer.raytrace_range = p.getDouble("raytrace_range", d.obstacle_layer.raytrace_range);
-  s.obstacle_layer.footprint_clearing_enabled =
-      p.getBool("footprint_clearing_enabled", d.obstacle_layer.footprint_clearing_enabled);
 
-  s.inflation_layer.inflation_radius = p.getDouble("inflation_radius", d.inflation_layer.inflation_radius);
-  s.inflation_layer.cost_scaling_factor = p.getDouble("cost_scaling_factor", d.inflation_layer.cost_scaling_factor);
-  s.inflation_layer.inflate_unknown = p.getBool("inflate_unknown", d.inflation_layer.inflate_unknown);
-
-  s.robots_layer = p.getBool("robots_layer", d.robots_layer);
-  s.robots.prediction_time = p.getDouble("robots_prediction_time", d.robots.prediction_time);
-  s.robots.prediction_step = p.getDouble("robots_prediction_step", d.robots.prediction_step);
-  const int prediction_cost = p.getInt("robots_prediction_cost", d.robots.prediction_cost);
-  s.robots_padding = p.getDouble("robots_padding", d.robots_padding);
-  s.robots_scan_margin = p.getDouble("robots_scan_margin", d.robots_scan_margin);
+  int prediction_cost = d.robots.prediction_cost;
+  if (costmap_nh.hasParam("plugins"))
+    readPlugins(p, costmap_nh, s, prediction_cost, w);
+  else
+  {
+    // costmap_2d's pre-layer form: static_map picks the static layer, map_type the obstacle layer.
+    s.static_map = p.getBool("static_map", d.static_map);
+    const std::string map_type = p.getString("map_type", "costmap");
+    if (map_type == "voxel")
+      w.push_back("parameter " + costmap_nh.resolveName("map_type") + ": voxel is read as a 2-D obstacle layer");
+    else if (map_type != "costmap")
+      throw std::runtime_error("parameter " + costmap_nh.resolveName("map_type") +
+                               ": expected costmap or voxel, got '" + map_type + "'");
+    readStaticLayer(p, costmap_nh, s, w);
+    readObstacleLayer(p, costmap_nh, s, w);
+    readInflationLayer(p, s);
+    // Written by the inflation layer's dynamic_reconfigure server; the flat keys win.
+    StrictParams ip{ros::NodeHandle(costmap_nh, s.inflation_layer_name)};
+    p.markKnown(s.inflation_layer_name);
+    const InflationLayerConfig flat = s.inflation_layer;
+    readInflationLayer(ip, s);
+    for (const char* key : {"inflation_radius", "cost_scaling_factor", "inflate_unknown"})
+      if (costmap_nh.hasParam(key))
+      {
+        if (std::string(key) == "inflation_radius") s.inflation_layer.inflation_radius = flat.inflation_radius;
+        if (std::string(key) == "cost_scaling_factor") s.inflation_layer.cost_scaling_factor = flat.cost_scaling_factor;
+        if (std::string(key) == "inflate_unknown") s.inflation_layer.inflate_unknown = flat.inflate_unknown;
+      }
+    ip.checkNoUnknown();
+    s.robots_layer = p.getBool("robots_layer", d.robots_layer);
+    readRobotsLayer(p, "robots_", s, prediction_cost);
+  }
   p.checkNoUnknown();
 
   const std::string ns = costmap_nh.getNamespace() + "/";
@@ -118,10 +345,12 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
   if (settings.robots_layer)
     robots_layer_ = static_cast<RobotsLayer*>(&layered_->addLayer(std::make_unique<RobotsLayer>(settings.robots)));
   // Last: inflate everything below, teammates included.
-  layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer));
+  if (settings.inflation)
+    inflation_layer_ = static_cast<InflationLayer*>(
+        &layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer)));
 
-  ros::NodeHandle root;
-  if (static_layer_) map_sub_ = root.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
+  // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
+  if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
   if (obstacle_layer_) scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
   if (settings.publish_frequency > 0.0)
     costmap_pub_ = private_nh.advertise<nav_msgs::OccupancyGrid>(name + "/costmap", 1, true);
@@ -253,6 +482,15 @@ void CostmapRos::clear()
   next_update_ = ros::Time(0);
 }
 
+void CostmapRos::setInflation(const InflationLayerConfig& config)
+{
+  if (!inflation_layer_) throw std::invalid_argument(name_ + " has no inflation layer");
+  inflation_layer_->setConfig(config);
+  settings_.inflation_layer = config;
+  layered_->requestFullUpdate();  // every inflated cell may change
+  next_update_ = ros::Time(0);
+}
+
 Costmap2D CostmapRos::staticCostmap() const
 {
   if (!last_map_) return Costmap2D();
@@ -261,7 +499,7 @@ Costmap2D CostmapRos::staticCostmap() const
   LayeredCostmap costmap(config);
   auto& static_layer =
       static_cast<StaticLayer&>(costmap.addLayer(std::make_unique<StaticLayer>(settings_.static_layer)));
-  costmap.addLayer(std::make_unique<InflationLayer>(settings_.inflation_layer));
+  if (settings_.inflation) costmap.addLayer(std::make_unique<InflationLayer>(settings_.inflation_layer));
   static_layer.setMap(last_map_->info.width, last_map_->info.height, last_map_->info.resolution,
                       last_map_->info.origin.position.x, last_map_->info.origin.position.y,
                       last_map_->data.data());

@@ -8,11 +8,18 @@
 
 namespace mbot_navigation
 {
-InflationLayer::InflationLayer(const InflationLayerConfig& config) : config_(config)
+InflationLayer::InflationLayer(const InflationLayerConfig& config)
+{
+  setConfig(config);
+}
+
+void InflationLayer::setConfig(const InflationLayerConfig& config)
 {
   if (!(config.inflation_radius >= 0.0) || !(config.cost_scaling_factor >= 0.0))
     throw std::invalid_argument(
         "InflationLayerConfig: 'inflation_radius' [m] and 'cost_scaling_factor' [1/m] must be >= 0");
+  config_ = config;
+  computeCaches();
 }
 
 void InflationLayer::onFootprintChanged(double robot_radius)

@@ -12,6 +12,7 @@
 
 #include "mbot_description/robot_model.h"
 #include <mbot_common/ros_edge.h>
+#include "mbot_navigation/move_base_params.h"
 #include "mbot_navigation/planner_factory.h"
 
 namespace mbot_navigation
@@ -20,149 +21,6 @@ using mbot_common::StrictParams;
 
 namespace
 {
-// =============================================================================================
-// parameters
-
-/// DWA keys may be given flat (~max_vel_x) or under ~DWAPlannerROS/ (dwa_local_planner's place),
-/// not both.
-class DwaParams
-{
-public:
-  DwaParams(const ros::NodeHandle& private_nh, StrictParams& flat, StrictParams& scoped)
-    : nh_(private_nh), flat_(flat), scoped_(scoped)
-  {
-  }
-  // The flat value (or the default) is the default of the scoped one; both readers mark the key
-  // as known, so that neither reports it as unknown.
-  double getDouble(const std::string& key, double d)
-  {
-    check(key);
-    return scoped_.getDouble(key, flat_.getDouble(key, d));
-  }
-  int getInt(const std::string& key, int d)
-  {
-    check(key);
-    return scoped_.getInt(key, flat_.getInt(key, d));
-  }
-  bool getBool(const std::string& key, bool d)
-  {
-    check(key);
-    return scoped_.getBool(key, flat_.getBool(key, d));
-  }
-
-private:
-  void check(const std::string& key) const
-  {
-    if (nh_.hasParam(key) && nh_.hasParam("DWAPlannerROS/" + key))
-      throw std::runtime_error("parameter " + nh_.resolveName(key) + " is also set as " +
-                               nh_.resolveName("DWAPlannerROS/" + key) + ": set it in one place");
-  }
-  ros::NodeHandle nh_;
-  StrictParams& flat_;
-  StrictParams& scoped_;
-};
-
-/// The DWA settings: dwa_local_planner's defaults, the robot model's limits, then the parameters.
-DwaConfig readDwaConfig(DwaParams& p, const mbot_description::RobotModel& model, double footprint_radius,
-                        double controller_frequency)
-{
-  DwaConfig c;
-  const mbot_description::Limits& lim = model.limits;
-  c.max_vel_x = lim.max_vel_x;
-  c.min_vel_x = lim.min_vel_x;
-  c.max_vel_y = lim.max_vel_y;
-  c.min_vel_y = -lim.max_vel_y;
-  c.max_vel_trans = std::max(lim.max_vel_x, lim.max_vel_y);
-  c.max_vel_theta = lim.max_vel_theta;
-  c.min_vel_theta = std::min(c.min_vel_theta, lim.max_vel_theta);
-  c.acc_lim_x = lim.acc_lim_x;
-  c.acc_lim_y = lim.acc_lim_y;
-  c.acc_lim_theta = lim.acc_lim_theta;
-
-  c.max_vel_trans = p.getDouble("max_vel_trans", c.max_vel_trans);
-  c.min_vel_trans = p.getDouble("min_vel_trans", c.min_vel_trans);
-  c.max_vel_x = p.getDouble("max_vel_x", c.max_vel_x);
-  c.min_vel_x = p.getDouble("min_vel_x", c.min_vel_x);
-  c.max_vel_y = p.getDouble("max_vel_y", c.max_vel_y);
-  c.min_vel_y = p.getDouble("min_vel_y", c.min_vel_y);
-  c.max_vel_theta = p.getDouble("max_vel_theta", c.max_vel_theta);
-  c.min_vel_theta = p.getDouble("min_vel_theta", c.min_vel_theta);
-  c.acc_lim_x = p.getDouble("acc_lim_x", c.acc_lim_x);
-  c.acc_lim_y = p.getDouble("acc_lim_y", c.acc_lim_y);
-  c.acc_lim_theta = p.getDouble("acc_lim_theta", c.acc_lim_theta);
-  c.trans_stopped_vel = p.getDouble("trans_stopped_vel", c.trans_stopped_vel);
-  c.theta_stopped_vel = p.getDouble("theta_stopped_vel", c.theta_stopped_vel);
-  c.xy_goal_tolerance = p.getDouble("xy_goal_tolerance", c.xy_goal_tolerance);
-  c.yaw_goal_tolerance = p.getDouble("yaw_goal_tolerance", c.yaw_goal_tolerance);
-  c.latch_xy_goal_tolerance = p.getBool("latch_xy_goal_tolerance", c.latch_xy_goal_tolerance);
-  c.sim_time = p.getDouble("sim_time", c.sim_time);
-  c.sim_granularity = p.getDouble("sim_granularity", c.sim_granularity);
-  c.angular_sim_granularity = p.getDouble("angular_sim_granularity", c.angular_sim_granularity);
-  c.vx_samples = p.getInt("vx_samples", c.vx_samples);
-  c.vy_samples = p.getInt("vy_samples", c.vy_samples);
-  c.vth_samples = p.getInt("vth_samples", c.vth_samples);
-  c.path_distance_bias = p.getDouble("path_distance_bias", c.path_distance_bias);
-  c.goal_distance_bias = p.getDouble("goal_distance_bias", c.goal_distance_bias);
-  c.occdist_scale = p.getDouble("occdist_scale", c.occdist_scale);
-  c.twirling_scale = p.getDouble("twirling_scale", c.twirling_scale);
-  c.forward_point_distance = p.getDouble("forward_point_distance", c.forward_point_distance);
-  c.oscillation_reset_dist = p.getDouble("oscillation_reset_dist", c.oscillation_reset_dist);
-  c.oscillation_reset_angle = p.getDouble("oscillation_reset_angle", c.oscillation_reset_angle);
-  c.prune_plan = p.getBool("prune_plan", c.prune_plan);
-  c.controller_frequency = controller_frequency;
-  c.footprint_radius = footprint_radius;
-  c.validate();  // std::invalid_argument naming the key
-  return c;
-}
-
-AStarConfig readAStarConfig(StrictParams& p)
-{
-  AStarConfig c;
-  c.neutral_cost = p.getDouble("neutral_cost", c.neutral_cost);
-  c.cost_factor = p.getDouble("cost_factor", c.cost_factor);
-  c.allow_unknown = p.getBool("allow_unknown", c.allow_unknown);
-  c.heuristic_weight = p.getDouble("heuristic_weight", c.heuristic_weight);
-  c.smooth_path = p.getBool("smooth_path", c.smooth_path);
-  c.smoothing_tolerance = p.getDouble("smoothing_tolerance", c.smoothing_tolerance);
-  c.smoothing_passes = p.getInt("smoothing_passes", c.smoothing_passes);
-  return c;
-}
-
-OmplConfig readOmplConfig(StrictParams& p)
-{
-  OmplConfig c;
-  c.planner = p.getString("planner", c.planner);
-  c.time_limit = p.getDouble("time_limit", c.time_limit);
-  const int seed = p.getInt("seed", static_cast<int>(c.seed));
-  if (seed <= 0) throw std::runtime_error("parameter OmplPlanner/seed: expected an integer > 0");
-  c.seed = static_cast<unsigned>(seed);
-  c.path_resolution = p.getDouble("path_resolution", c.path_resolution);
-  c.simplify = p.getBool("simplify", c.simplify);
-  c.simplify_time_limit = p.getDouble("simplify_time_limit", c.simplify_time_limit);
-  c.cost_weight = p.getDouble("cost_weight", c.cost_weight);
-  return c;
-}
-
-std::vector<std::string> readNameList(const ros::NodeHandle& nh, const std::string& key)
-{
-  std::vector<std::string> names;
-  XmlRpc::XmlRpcValue v;
-  if (!nh.getParam(key, v)) return names;
-  const std::string expected = "parameter " + nh.resolveName(key) + ": expected a list of robot names";
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeArray) throw std::runtime_error(expected);
-  for (int i = 0; i < v.size(); ++i)
-  {
-    if (v[i].getType() != XmlRpc::XmlRpcValue::TypeString) throw std::runtime_error(expected);
-    names.push_back(static_cast<std::string>(v[i]));
-  }
-  return names;
-}
-
-void require(bool ok, const ros::NodeHandle& nh, const std::string& key, const std::string& expected)
-{
-  if (!ok) throw std::runtime_error("parameter " + nh.resolveName(key) + ": expected " + expected);
-}
-
 geometry_msgs::PoseStamped toPoseStamped(const Pose2D& p, const std::string& frame, const ros::Time& stamp)
 {
   geometry_msgs::PoseStamped out;
@@ -259,108 +117,30 @@ std::vector<TeammateState> TeammateTracker::states(const ros::Time& now) const
 NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   : nh_(nh), private_nh_(private_nh)
 {
-  StrictParams p(private_nh_);
-  robot_ = mbot_common::robotName(p, nh_);
-  own_model_ = p.getString("model", "mbot");
   description_dir_ = ros::package::getPath("mbot_description");
   if (description_dir_.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
-  mbot_description::RobotModel model;
-  try
-  {
-    model = mbot_description::loadRobotModel(description_dir_, own_model_);
-  }
-  catch (const mbot_description::ModelError& e)
-  {
-    throw std::runtime_error("parameter " + private_nh_.resolveName("model") + " = '" + own_model_ + "': " + e.what());
-  }
-  own_radius_ = model.footprint_radius;
+  ParamWarnings warnings;
+  const NavParams params = readNavParams(nh_, private_nh_, description_dir_, warnings);
+  for (const std::string& w : warnings) ROS_WARN("%s", w.c_str());
+  robot_ = params.robot;
+  own_model_ = params.model;
+  own_radius_ = params.footprint_radius;
   model_radius_[own_model_] = own_radius_;
-
-  // --- move_base's own parameters
-  const std::string global_planner_name = p.getString("base_global_planner", "astar");
-  const std::string local_planner_name = p.getString("base_local_planner", "dwa");
-  require(local_planner_name == "dwa" || local_planner_name == "dwa_local_planner/DWAPlannerROS", private_nh_,
-          "base_local_planner", "'dwa' (the only local planner), got '" + local_planner_name + "'");
-  const double controller_frequency = p.getDouble("controller_frequency", 20.0);
-  require(controller_frequency > 0.0, private_nh_, "controller_frequency", "a number > 0 [Hz]");
-  NavigatorConfig nav;
-  nav.planner_frequency = p.getDouble("planner_frequency", nav.planner_frequency);
-  nav.planner_patience = p.getDouble("planner_patience", nav.planner_patience);
-  nav.controller_patience = p.getDouble("controller_patience", nav.controller_patience);
-  nav.oscillation_timeout = p.getDouble("oscillation_timeout", nav.oscillation_timeout);
-  nav.oscillation_distance = p.getDouble("oscillation_distance", nav.oscillation_distance);
-  nav.recovery_behavior_enabled = p.getBool("recovery_behavior_enabled", nav.recovery_behavior_enabled);
-  controller_patience_ = nav.controller_patience;
-  const bool clearing_rotation_allowed = p.getBool("clearing_rotation_allowed", true);
-  BackUpRecoveryConfig back_up;
-  back_up.distance = p.getDouble("back_up_distance", back_up.distance);
-  back_up.speed = p.getDouble("back_up_speed", back_up.speed);
-  require(back_up.distance >= 0.0, private_nh_, "back_up_distance", "a number >= 0 [m] (0: no backing up)");
-  require(back_up.speed > 0.0, private_nh_, "back_up_speed", "a number > 0 [m/s]");
-
-  // --- teammates
-  const std::vector<std::string> robots = readNameList(private_nh_, "robots");
-  p.markKnown("robots");
-  const std::string robots_source = p.getString("robots_source", "ground_truth");
-  require(robots_source == "ground_truth" || robots_source == "odom", private_nh_, "robots_source",
-          "'ground_truth' or 'odom', got '" + robots_source + "'");
-  const double robots_timeout = p.getDouble("robots_timeout", 1.0);
-
-  // --- costmaps
-  CostmapRosSettings global_defaults;
-  global_defaults.robot_base_frame = mbot_common::prefixedFrame(robot_, "base_footprint");
-  global_defaults.costmap.robot_radius = own_radius_;
-  global_defaults.costmap.rolling_window = false;
-  global_defaults.update_frequency = 5.0;
-  global_defaults.publish_frequency = 1.0;
-  CostmapRosSettings local_defaults = global_defaults;
-  local_defaults.costmap.rolling_window = true;
-  local_defaults.costmap.width = local_defaults.costmap.height = 4.0;
-  local_defaults.update_frequency = 10.0;
-  local_defaults.publish_frequency = 2.0;
-  p.markKnown("global_costmap");
-  p.markKnown("local_costmap");
-  const CostmapRosSettings global_settings =
-      readCostmapSettings(ros::NodeHandle(private_nh_, "global_costmap"), global_defaults);
-  const CostmapRosSettings local_settings =
-      readCostmapSettings(ros::NodeHandle(private_nh_, "local_costmap"), local_defaults);
-  if (global_settings.global_frame != local_settings.global_frame ||
-      global_settings.robot_base_frame != local_settings.robot_base_frame)
-    throw std::runtime_error("parameters " + private_nh_.resolveName("global_costmap") + " and " +
-                             private_nh_.resolveName("local_costmap") +
-                             ": global_frame and robot_base_frame must be the same in both (the plan is shared)");
+  controller_patience_ = params.nav.controller_patience;
+  const CostmapRosSettings& global_settings = params.global_costmap;
+  const CostmapRosSettings& local_settings = params.local_costmap;
   global_frame_ = global_settings.global_frame;
   robot_base_frame_ = global_settings.robot_base_frame;
   transform_tolerance_ = global_settings.transform_tolerance;
-
-  // --- planners
-  GlobalPlannerParams planner_params;
-  {
-    StrictParams gp(ros::NodeHandle(private_nh_, "GlobalPlanner"));
-    p.markKnown("GlobalPlanner");
-    planner_params.astar = readAStarConfig(gp);
-    gp.checkNoUnknown();
-    StrictParams op(ros::NodeHandle(private_nh_, "OmplPlanner"));
-    p.markKnown("OmplPlanner");
-    planner_params.ompl = readOmplConfig(op);
-    op.checkNoUnknown();
-  }
-  nav.allow_unknown = planner_params.astar.allow_unknown;
-  goal_checker_ = StaticGoalChecker(nav.allow_unknown);  // "unreachable" as the planner sees it
-  DwaConfig dwa;
-  {
-    StrictParams dp(ros::NodeHandle(private_nh_, "DWAPlannerROS"));
-    p.markKnown("DWAPlannerROS");
-    DwaParams dwa_params(private_nh_, p, dp);
-    dwa = readDwaConfig(dwa_params, model, local_settings.costmap.robot_radius, controller_frequency);
-    dp.checkNoUnknown();
-  }
-  p.checkNoUnknown();
+  goal_checker_ = StaticGoalChecker(params.nav.allow_unknown);  // "unreachable" as the planner sees it
+  const DwaConfig& dwa = params.dwa;
+  const double controller_frequency = params.controller_frequency;
+  const std::string& global_planner_name = params.global_planner;
 
   std::unique_ptr<GlobalPlanner> global_planner;
   try
   {
-    global_planner = makeGlobalPlanner(global_planner_name, planner_params);
+    global_planner = makeGlobalPlanner(global_planner_name, params.planners);
   }
   catch (const std::invalid_argument& e)
   {
@@ -378,7 +158,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     global_costmap_->clear();
     local_costmap_->clear();
   }));
-  if (clearing_rotation_allowed)
+  if (params.clearing_rotation_allowed)
   {
     RotateRecoveryConfig rotate;
     rotate.max_vel_theta = std::min(1.0, dwa.max_vel_theta);
@@ -387,16 +167,17 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     rotate.control_period = 1.0 / controller_frequency;
     recoveries.push_back(std::make_unique<RotateRecovery>(rotate));
   }
+  BackUpRecoveryConfig back_up = params.back_up;
   back_up.footprint_radius = local_settings.costmap.robot_radius;
-  back_up.speed = std::min(back_up.speed, -model.limits.min_vel_x);  // a robot that cannot reverse does not
+  back_up.speed = std::min(back_up.speed, -params.model_min_vel_x);  // a robot that cannot reverse does not
   if (back_up.distance > 0.0 && back_up.speed > 0.0) recoveries.push_back(std::make_unique<BackUpRecovery>(back_up));
-  navigator_ = std::make_unique<Navigator>(nav, dwa, std::move(global_planner), std::move(recoveries));
+  navigator_ = std::make_unique<Navigator>(params.nav, dwa, std::move(global_planner), std::move(recoveries));
 
   teammates_ = std::make_unique<TeammateTracker>(
       *tf_, robot_, global_frame_,
-      robots_source == "odom" ? TeammateTracker::Source::ODOM : TeammateTracker::Source::GROUND_TRUTH, robots,
-      robots_timeout, [this](const std::string& name) { return teammateRadius(name); });
-  if (robots.empty())
+      params.robots_source == "odom" ? TeammateTracker::Source::ODOM : TeammateTracker::Source::GROUND_TRUTH,
+      params.robots, params.robots_timeout, [this](const std::string& name) { return teammateRadius(name); });
+  if (params.robots.empty())
   {
     teammates_->discover();
     discovery_timer_ = nh_.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
@@ -414,10 +195,11 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   make_plan_srv_ = private_nh_.advertiseService("make_plan", &NavNode::onMakePlan, this);
   clear_costmaps_srv_ = private_nh_.advertiseService("clear_costmaps", &NavNode::onClearCostmaps, this);
   server_ = std::make_unique<ActionServer>(nh_, "move_base", false);
-  server_->registerGoalCallback([this]() { onGoal(); });
+  // No goal callback: the control cycle accepts new goals (see nav_node.h).
   server_->registerPreemptCallback([this]() { onPreempt(); });
   control_period_ = 1.0 / controller_frequency;
   cycle_timer_ = nh_.createTimer(ros::Duration(control_period_), &NavNode::cycle, this);
+  startReconfigureServers();
 
   ROS_INFO("%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
            "waiting for the map and the robot's pose",
@@ -454,7 +236,7 @@ double NavNode::teammateRadius(const std::string& name)
 // =============================================================================================
 // NavNode: the control cycle
 
-bool NavNode::robotPose(Pose2D& pose, std::string& error) const
+bool NavNode::robotPose(Pose2D& pose, std::string& error, ros::Time* stamp) const
 {
   // Under load this node's tf listener can fall behind /clock. Wait a little for the pose of one
   // control period ago rather than steer on an older one: at most one period of sim time, and at
@@ -485,6 +267,7 @@ bool NavNode::robotPose(Pose2D& pose, std::string& error) const
     return false;
   }
   pose = mbot_common::toPose2D(t.transform);
+  if (stamp) *stamp = t.header.stamp;
   return true;
 }
 
@@ -495,7 +278,8 @@ void NavNode::cycle(const ros::TimerEvent&)
 
   Pose2D pose;
   std::string pose_error;
-  const bool has_pose = robotPose(pose, pose_error);
+  ros::Time pose_stamp;
+  const bool has_pose = robotPose(pose, pose_error, &pose_stamp);
   if (has_pose)
   {
     last_pose_time_ = now;
@@ -526,6 +310,8 @@ void NavNode::cycle(const ros::TimerEvent&)
     ROS_INFO("%s: ready: action server %s started", private_nh_.getNamespace().c_str(),
              nh_.resolveName("move_base").c_str());
   }
+
+  if (server_->isNewGoalAvailable()) acceptGoal();
 
   if (navigator_->state() == NavState::IDLE)
   {
@@ -577,11 +363,134 @@ void NavNode::cycle(const ros::TimerEvent&)
     case NavOutcome::ACTIVE:
     {
       move_base_msgs::MoveBaseFeedback feedback;
-      feedback.base_position = toPoseStamped(pose, global_frame_, now);
+      feedback.base_position = toPoseStamped(pose, global_frame_, pose_stamp);  // as move_base: tf's stamp
       server_->publishFeedback(feedback);
       break;
     }
     case NavOutcome::NONE: break;
+  }
+}
+
+void NavNode::startReconfigureServers()
+{
+  // Each server starts with the values in force (not the .cfg defaults): updateConfig() before
+  // setCallback(), whose first call then applies the same values.
+  dwa_server_ = std::make_unique<dynamic_reconfigure::Server<DWAPlannerConfig>>(
+      reconfigure_mutex_, ros::NodeHandle(private_nh_, "DWAPlannerROS"));
+  const DwaConfig& d = navigator_->localPlanner().config();
+  DWAPlannerConfig c;
+  c.max_vel_trans = d.max_vel_trans;
+  c.min_vel_trans = d.min_vel_trans;
+  c.max_vel_x = d.max_vel_x;
+  c.min_vel_x = d.min_vel_x;
+  c.max_vel_y = d.max_vel_y;
+  c.min_vel_y = d.min_vel_y;
+  c.max_vel_theta = d.max_vel_theta;
+  c.min_vel_theta = d.min_vel_theta;
+  c.acc_lim_x = d.acc_lim_x;
+  c.acc_lim_y = d.acc_lim_y;
+  c.acc_lim_theta = d.acc_lim_theta;
+  c.trans_stopped_vel = d.trans_stopped_vel;
+  c.theta_stopped_vel = d.theta_stopped_vel;
+  c.xy_goal_tolerance = d.xy_goal_tolerance;
+  c.yaw_goal_tolerance = d.yaw_goal_tolerance;
+  c.latch_xy_goal_tolerance = d.latch_xy_goal_tolerance;
+  c.sim_time = d.sim_time;
+  c.sim_granularity = d.sim_granularity;
+  c.angular_sim_granularity = d.angular_sim_granularity;
+  c.vx_samples = d.vx_samples;
+  c.vy_samples = d.vy_samples;
+  c.vth_samples = d.vth_samples;
+  c.path_distance_bias = d.path_distance_bias;
+  c.goal_distance_bias = d.goal_distance_bias;
+  c.occdist_scale = d.occdist_scale;
+  c.twirling_scale = d.twirling_scale;
+  c.forward_point_distance = d.forward_point_distance;
+  c.oscillation_reset_dist = d.oscillation_reset_dist;
+  c.oscillation_reset_angle = d.oscillation_reset_angle;
+  c.prune_plan = d.prune_plan;
+  dwa_server_->updateConfig(c);
+  dwa_server_->setCallback([this](DWAPlannerConfig& config, uint32_t) { onDwaReconfigure(config); });
+
+  for (CostmapRos* costmap : {global_costmap_.get(), local_costmap_.get()})
+  {
+    if (!costmap->settings().inflation) continue;
+    const InflationLayerConfig& i = costmap->settings().inflation_layer;
+    inflation_servers_.push_back(std::make_unique<dynamic_reconfigure::Server<InflationConfig>>(
+        reconfigure_mutex_, ros::NodeHandle(private_nh_, costmap->name() + "/" + costmap->settings().inflation_layer_name)));
+    InflationConfig ic;
+    ic.inflation_radius = i.inflation_radius;
+    ic.cost_scaling_factor = i.cost_scaling_factor;
+    ic.inflate_unknown = i.inflate_unknown;
+    inflation_servers_.back()->updateConfig(ic);
+    inflation_servers_.back()->setCallback(
+        [this, costmap](InflationConfig& config, uint32_t) { onInflationReconfigure(*costmap, config); });
+  }
+}
+
+void NavNode::onDwaReconfigure(DWAPlannerConfig& c)
+{
+  DwaConfig d = navigator_->localPlanner().config();  // keeps the footprint and the control rate
+  d.max_vel_trans = c.max_vel_trans;
+  d.min_vel_trans = c.min_vel_trans;
+  d.max_vel_x = c.max_vel_x;
+  d.min_vel_x = c.min_vel_x;
+  d.max_vel_y = c.max_vel_y;
+  d.min_vel_y = c.min_vel_y;
+  d.max_vel_theta = c.max_vel_theta;
+  d.min_vel_theta = c.min_vel_theta;
+  d.acc_lim_x = c.acc_lim_x;
+  d.acc_lim_y = c.acc_lim_y;
+  d.acc_lim_theta = c.acc_lim_theta;
+  d.trans_stopped_vel = c.trans_stopped_vel;
+  d.theta_stopped_vel = c.theta_stopped_vel;
+  d.xy_goal_tolerance = c.xy_goal_tolerance;
+  d.yaw_goal_tolerance = c.yaw_goal_tolerance;
+  d.latch_xy_goal_tolerance = c.latch_xy_goal_tolerance;
+  d.sim_time = c.sim_time;
+  d.sim_granularity = c.sim_granularity;
+  d.angular_sim_granularity = c.angular_sim_granularity;
+  d.vx_samples = c.vx_samples;
+  d.vy_samples = c.vy_samples;
+  d.vth_samples = c.vth_samples;
+  d.path_distance_bias = c.path_distance_bias;
+  d.goal_distance_bias = c.goal_distance_bias;
+  d.occdist_scale = c.occdist_scale;
+  d.twirling_scale = c.twirling_scale;
+  d.forward_point_distance = c.forward_point_distance;
+  d.oscillation_reset_dist = c.oscillation_reset_dist;
+  d.oscillation_reset_angle = c.oscillation_reset_angle;
+  d.prune_plan = c.prune_plan;
+  try
+  {
+    navigator_->setLocalPlannerConfig(d);
+    ROS_INFO("%s/DWAPlannerROS: new settings (max_vel_x %.2f m/s, max_vel_theta %.2f rad/s, sim_time %.2f s)",
+             private_nh_.getNamespace().c_str(), d.max_vel_x, d.max_vel_theta, d.sim_time);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    ROS_ERROR("%s/DWAPlannerROS: settings refused, the previous ones stay: %s", private_nh_.getNamespace().c_str(),
+              e.what());
+  }
+}
+
+void NavNode::onInflationReconfigure(CostmapRos& costmap, InflationConfig& c)
+{
+  InflationLayerConfig config;
+  config.inflation_radius = c.inflation_radius;
+  config.cost_scaling_factor = c.cost_scaling_factor;
+  config.inflate_unknown = c.inflate_unknown;
+  try
+  {
+    costmap.setInflation(config);
+    if (&costmap == global_costmap_.get()) goal_checker_map_count_ = 0;  // the goal checks inflate as it does
+    ROS_INFO("%s/%s: inflation_radius %.2f m, cost_scaling_factor %.1f", private_nh_.getNamespace().c_str(),
+             costmap.name().c_str(), config.inflation_radius, config.cost_scaling_factor);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    ROS_ERROR("%s/%s: inflation settings refused: %s", private_nh_.getNamespace().c_str(), costmap.name().c_str(),
+              e.what());
   }
 }
 
@@ -654,7 +563,7 @@ std::string NavNode::checkGoal(const geometry_msgs::PoseStamped& goal, Pose2D& o
   return goal_checker_.check(has_pose ? &robot : nullptr, out);
 }
 
-void NavNode::onGoal()
+void NavNode::acceptGoal()
 {
   const move_base_msgs::MoveBaseGoal::ConstPtr goal = server_->acceptNewGoal();
   if (!goal) return;
@@ -677,7 +586,7 @@ void NavNode::onGoal()
 
 void NavNode::onPreempt()
 {
-  // Called for a cancel and before a new goal replaces the current one (then onGoal follows).
+  // Called for a cancel and when a new goal arrives (the next cycle accepts it).
   if (!server_->isActive()) return;
   navigator_->cancel();
   publishZero();

@@ -48,6 +48,13 @@ Navigator::Navigator(const NavigatorConfig& config, const DwaConfig& dwa, std::u
         "Navigator: planner_patience, controller_patience, planner_frequency and oscillation_timeout must be >= 0");
 }
 
+void Navigator::setLocalPlannerConfig(const DwaConfig& dwa)
+{
+  auto planner = std::make_unique<DwaPlanner>(dwa);  // validates
+  if (!plan_.empty()) planner->setPlan(plan_);
+  dwa_ = std::move(planner);
+}
+
 void Navigator::setGoal(const Pose2D& goal, double now)
 {
   goal_ = goal;

@@ -9,7 +9,13 @@
  * nav node owns two: `global_costmap` (the size of the map) and `local_costmap` (a rolling window
  * around the robot). Both must use the same global_frame (the plan is shared between them).
  *
- * Parameters (in ~<name>/, flat as in costmap_2d's pre-plugin style; all optional):
+ * Parameters (in ~<name>/, all optional), in either of costmap_2d's two forms (move_base_params.h
+ * tells how standard keys this node does not implement are treated; docs/move_base_keys.md lists them):
+ *   - `plugins: [{name: N, type: T}, ...]`: the layers listed, T one of costmap_2d::StaticLayer,
+ *     costmap_2d::ObstacleLayer (VoxelLayer: read as a 2-D obstacle layer), costmap_2d::InflationLayer,
+ *     mbot_navigation::RobotsLayer; each layer's keys in ~<name>/N/ (`enabled: false` leaves it out);
+ *   - flat, costmap_2d's pre-layer style (the keys below); `static_map` and `map_type` as there.
+ * Flat keys:
  *   global_frame (map), robot_base_frame (<robot>/base_footprint), update_frequency [Hz],
  *   publish_frequency [Hz], transform_tolerance [s], rolling_window, width [m], height [m],
  *   resolution [m/cell], origin_x [m], origin_y [m], robot_radius [m] (default: the URDF's),
@@ -62,7 +68,9 @@ struct CostmapRosSettings
   std::string scan_topic = "scan";  ///< "" = no obstacle layer
   ObstacleLayerConfig obstacle_layer;
 
+  bool inflation = true;  ///< false only when `plugins` leaves the inflation layer out
   InflationLayerConfig inflation_layer;
+  std::string inflation_layer_name = "inflation_layer";  ///< its namespace (dynamic_reconfigure)
 
   bool robots_layer = true;
   RobotsLayerConfig robots;
@@ -72,10 +80,12 @@ struct CostmapRosSettings
 
 /**
  * @brief Read ~<name>/ (see the file comment) strictly: a wrong type or an unknown key throws
- *        std::runtime_error naming the parameter.
+ *        std::runtime_error naming the parameter; a standard costmap_2d key that this node does
+ *        not implement adds one line to `warnings` (when given) and is ignored.
  * @param defaults the values of keys that are not set (the caller fills robot_radius, frames...)
  */
-CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& defaults);
+CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& defaults,
+                                       std::vector<std::string>* warnings = nullptr);
 
 /// @brief costmap_2d's translation of a cost to an OccupancyGrid value: 0 -> 0, 1..252 -> 1..98,
 ///        INSCRIBED -> 99, LETHAL -> 100, NO_INFORMATION -> -1.
@@ -129,6 +139,10 @@ public:
   /// @brief Forget what the laser and the teammates marked (clear_costmaps); the map stays.
   void clear();
 
+  /// @brief New inflation settings (dynamic_reconfigure), in force from the next update().
+  /// @throws std::invalid_argument for values out of range
+  void setInflation(const InflationLayerConfig& config);
+
   const Costmap2D& costmap() const { return layered_->costmap(); }
   const CostmapRosSettings& settings() const { return settings_; }
   const std::string& name() const { return name_; }
@@ -151,6 +165,7 @@ private:
   StaticLayer* static_layer_ = nullptr;
   ObstacleLayer* obstacle_layer_ = nullptr;
   RobotsLayer* robots_layer_ = nullptr;
+  InflationLayer* inflation_layer_ = nullptr;
 
   ros::Subscriber map_sub_, scan_sub_;
   ros::Publisher costmap_pub_;

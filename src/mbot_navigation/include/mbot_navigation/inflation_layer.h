@@ -52,6 +52,11 @@ public:
    */
   void inflate(Costmap2D& grid);
 
+  /// @brief New settings (dynamic_reconfigure); the caller rewrites the master grid.
+  /// @throws std::invalid_argument for a negative radius or factor
+  void setConfig(const InflationLayerConfig& config);
+  const InflationLayerConfig& config() const { return config_; }
+
   double inscribedRadius() const { return inscribed_radius_; }  ///< [m]
 
 private:

@@ -55,6 +55,8 @@ public:
 
   /// @brief Reset every layer and rewrite the whole master at the next update.
   void reset();
+  /// @brief Rewrite the whole master at the next update (a layer's settings changed).
+  void requestFullUpdate() { full_update_ = true; }
 
   const Costmap2D& costmap() const { return costmap_; }
   const LayeredCostmapConfig& config() const { return config_; }

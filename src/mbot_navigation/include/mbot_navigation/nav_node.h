@@ -16,12 +16,18 @@
  * no older than global_costmap/transform_tolerance; without it the robot stands still, and after
  * controller_patience the goal is aborted.
  * The action server starts once the map and the robot's pose are there (clients' wait_for_server
- * waits for that).
+ * waits for that). A new goal is accepted (or rejected) by the next control cycle, not inside the
+ * goal callback, as move_base does: a SimpleActionClient stores its goal handle only after
+ * send_goal returns, and an instant status would reach it before that.
+ * Live tuning (dynamic_reconfigure): ~DWAPlannerROS (cfg/DWAPlanner.cfg) and
+ * ~global_costmap/inflation_layer, ~local_costmap/inflation_layer (cfg/Inflation.cfg).
  *
- * Parameters (~, all optional; see config/nav_*.yaml for the values the launch files use):
+ * Parameters (~, all optional; see config/nav_*.yaml for the values the launch files use; read by
+ * move_base_params.h, which also takes move_base's standard keys and planner names):
  *   robot (the namespace), model (mbot): the robot model (mbot_description) that gives the
  *     footprint radius and the velocity and acceleration limits;
- *   base_global_planner ("astar" | "ompl"), base_local_planner ("dwa");
+ *   base_global_planner ("astar" | "ompl"; navfn/NavfnROS and global_planner/GlobalPlanner run
+ *   the A*), base_local_planner ("dwa" | dwa_local_planner/DWAPlannerROS);
  *   controller_frequency [Hz] 20, planner_frequency [Hz] 0, planner_patience [s] 5,
  *   controller_patience [s] 15, oscillation_timeout [s] 0, oscillation_distance [m] 0.5,
  *   recovery_behavior_enabled (true), clearing_rotation_allowed (true), back_up_distance [m] 0.3,
@@ -32,11 +38,12 @@
  *   (the costmaps' robots_padding draws them bigger than their footprint);
  *   global_costmap/..., local_costmap/... (costmap_ros.h);
  *   DWAPlannerROS/<key> or <key> (flat) for the DWA settings, with dwa_local_planner's names
- *     (trajectory.h DwaConfig; setting one key in both places is an error; limits default to the
+ *     (trajectory.h DwaConfig; a key set in both places must agree; limits default to the
  *     robot model's);
  *   GlobalPlanner/<key>: the A* settings (astar_planner.h AStarConfig, global_planner's names);
  *   OmplPlanner/<key>: the OMPL planner's (ompl_planner.h OmplConfig).
- * Unknown keys and wrong types stop the node with a message naming the parameter.
+ * Unknown keys and wrong types stop the node with a message naming the parameter; a standard
+ * move_base key that this node does not implement is one warning (docs/move_base_keys.md).
  */
 #pragma once
 
@@ -47,6 +54,7 @@
 #include <vector>
 
 #include <actionlib/server/simple_action_server.h>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <move_base_msgs/MoveBaseAction.h>
 #include <nav_msgs/GetPlan.h>
@@ -57,6 +65,8 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "mbot_navigation/DWAPlannerConfig.h"
+#include "mbot_navigation/InflationConfig.h"
 #include "mbot_navigation/costmap_ros.h"
 #include "mbot_navigation/goal_checks.h"
 #include "mbot_navigation/navigator.h"
@@ -125,7 +135,7 @@ private:
 
   // --- ROS callbacks
   void cycle(const ros::TimerEvent& event);
-  void onGoal();
+  void acceptGoal();
   void onPreempt();
   void onSimpleGoal(const geometry_msgs::PoseStamped::ConstPtr& goal);
   void onOdom(const nav_msgs::Odometry::ConstPtr& odom);
@@ -134,7 +144,8 @@ private:
 
   // --- helpers
   /// The robot in the global frame from tf (latest); false and `error` when tf cannot tell.
-  bool robotPose(Pose2D& pose, std::string& error) const;
+  /// `stamp` (when given) is the transform's time.
+  bool robotPose(Pose2D& pose, std::string& error, ros::Time* stamp = nullptr) const;
   /// "" and `out` (global frame) for a usable goal, else the status text that says why not.
   std::string goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, Pose2D& out) const;
   /// Why the goal cannot be taken ("" when it can); `out` is the goal in the global frame.
@@ -142,6 +153,10 @@ private:
   double teammateRadius(const std::string& name);
   void publishPath(const ros::Publisher& pub, const std::vector<Pose2D>& path, const ros::Time& stamp) const;
   void publishZero();
+  /// Start the dynamic_reconfigure servers with the settings in force.
+  void startReconfigureServers();
+  void onDwaReconfigure(DWAPlannerConfig& config);
+  void onInflationReconfigure(CostmapRos& costmap, InflationConfig& config);
 
   ros::NodeHandle nh_, private_nh_;
   std::string robot_;
@@ -169,6 +184,9 @@ private:
   ros::ServiceServer make_plan_srv_, clear_costmaps_srv_;
   ros::Timer cycle_timer_;
   ros::WallTimer discovery_timer_;
+  boost::recursive_mutex reconfigure_mutex_;  ///< given to the servers, so that updateConfig() is safe
+  std::unique_ptr<dynamic_reconfigure::Server<DWAPlannerConfig>> dwa_server_;
+  std::vector<std::unique_ptr<dynamic_reconfigure::Server<InflationConfig>>> inflation_servers_;
 
   Twist2D velocity_;          ///< from the robot's odometry, robot frame
   ros::Time last_pose_time_;  ///< last time tf gave the robot's pose

@@ -98,6 +98,9 @@ public:
   void setGoal(const Pose2D& goal, double now);
   /// @brief Drop the current goal (preempted); the next cycle commands zero.
   void cancel();
+  /// @brief New local planner settings (dynamic_reconfigure), in force from the next cycle; the
+  ///        current plan is kept. @throws std::invalid_argument for a setting out of range
+  void setLocalPlannerConfig(const DwaConfig& dwa);
   NavState state() const { return state_; }
   const Pose2D& goal() const { return goal_; }
 
