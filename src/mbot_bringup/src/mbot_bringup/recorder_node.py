@@ -1,7 +1,6 @@
 """recorder node: records what the simulation does for `~duration` sim seconds, prints a summary,
 writes `~output` (JSON) and shuts down (mark it required in a launch file to end the run)."""
 import functools
-import math
 import threading
 import time
 
@@ -14,10 +13,7 @@ from sensor_msgs.msg import LaserScan
 from mbot_bringup.fleet_topics import discover_robots
 from mbot_bringup.goal_tour import STATUS_NAMES
 from mbot_bringup.recording import Recording
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+from mbot_common.geometry import yaw_of
 
 
 def locked(method):

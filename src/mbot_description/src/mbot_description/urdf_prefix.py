@@ -3,7 +3,7 @@
 ROS Noetic's robot_state_publisher has no ``tf_prefix``: it names each frame after its URDF link.
 So every robot gets its own copy of the URDF in which each link and joint name carries the
 robot's name, ``base_link`` -> ``robot_3/base_link``, and robot_state_publisher then publishes
-``robot_3/base_footprint -> robot_3/base_link -> robot_3/base_laser`` as DESIGN.md asks.
+``robot_3/base_footprint -> robot_3/base_link -> robot_3/base_laser`` as docs/ARCHITECTURE.md lists.
 
 What is renamed (everything that names a link or a joint):
   <link name>, <joint name>, <joint><parent link> and <child link>, <joint><mimic joint>,

@@ -1,5 +1,5 @@
 """The two URDFs: check_urdf accepts them, every body has an inertial, the frames follow
-DESIGN.md."""
+docs/ARCHITECTURE.md (names and frames)."""
 import math
 import os
 import subprocess

@@ -29,8 +29,8 @@ import sys
 import time
 
 import numpy as np
-import yaml
 
+from mbot_common.world import load_world
 from mbot_navigation import grid_paths
 
 ROBOT_RADIUS = 0.15  # [m] mbot's footprint; the clearance default keeps goals well away from walls
@@ -45,15 +45,12 @@ def default_world():
 def static_obstacles(world_path):
     """The world file's static obstacles as discs (x, y, radius) [m]: a box by its circumscribed
     circle (half its diagonal), a cylinder by its radius."""
-    with open(world_path) as f:
-        world = yaml.safe_load(f) or {}
     discs = []
-    for o in world.get("obstacles", []) or []:
-        x, y = float(o["pose"][0]), float(o["pose"][1])
-        if o.get("shape") == "box":
-            discs.append((x, y, 0.5 * math.hypot(*[float(v) for v in o["size"]])))
+    for o in load_world(world_path).obstacles:
+        if o.shape.type == "box":
+            discs.append((o.pose.x, o.pose.y, 0.5 * math.hypot(o.shape.length, o.shape.width)))
         else:
-            discs.append((x, y, float(o["radius"])))
+            discs.append((o.pose.x, o.pose.y, o.shape.radius))
     return discs
 
 
