@@ -20,7 +20,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
-from localization_test_tools import wait_for_wall as wait_for
+from mbot_common.waits import wait_for_wall as wait_for  # these tests publish /clock themselves
 
 PKG = "mbot_localization"
 STEPS = 25

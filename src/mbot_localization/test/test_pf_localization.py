@@ -22,7 +22,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from localization_test_tools import wait_for_wall as wait_for
+from mbot_common.waits import wait_for_wall as wait_for  # these tests publish /clock themselves
 
 PKG = "mbot_localization"
 RESOLUTION = 0.05  # [m/cell]

@@ -21,7 +21,8 @@ from nav_msgs.srv import GetPlan, GetPlanRequest
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
-from nav_test_tools import Track, action_client, make_goal, state_name, wait_for_wall, wait_until
+from mbot_common.waits import wait_for_wall
+from nav_test_tools import Track, action_client, make_goal, state_name, wait_until
 
 ROBOT = "robot_0"
 START = (3.0, -4.0)             # the world file's
