@@ -54,7 +54,7 @@ def run_json(cmd):
     full = ["taskset", "-c", "0"] + cmd if shutil.which("taskset") else cmd
     print("$ " + " ".join(cmd), file=sys.stderr)
     out = subprocess.run(full, check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
-    lines = [l for l in out.strip().splitlines() if l.startswith("{")]
+    lines = [line for line in out.strip().splitlines() if line.startswith("{")]
     if not lines:
         sys.exit("%s printed no JSON:\n%s" % (cmd[0], out))
     return json.loads(lines[-1])
@@ -64,7 +64,7 @@ def machine():
     cpu = ""
     try:
         with open("/proc/cpuinfo") as f:
-            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
     except (OSError, StopIteration):
         pass
     return "%s, %d cores, %s" % (cpu or platform.processor(), os.cpu_count(), platform.platform())
@@ -114,7 +114,7 @@ def nav_trial(runs, rtf):
     out = subprocess.run(["/usr/bin/python3", script, "--runs", str(runs), "--seed", "1",
                           "--real-time-factor", str(rtf), "--json"],
                          check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
-    result = json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
+    result = json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
     result["real_time_factor"] = rtf
     return result
 
@@ -150,7 +150,7 @@ def bench_formation(seeds, sizes):
     out = subprocess.run(["/usr/bin/python3", "-m", "mbot_follower.formation_bench", "--seeds", str(seeds),
                           "--sizes", sizes, "--json"], check=True, stdout=subprocess.PIPE,
                          universal_newlines=True).stdout
-    return json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
+    return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
 
 
 def print_table(result):
@@ -164,7 +164,7 @@ def print_table(result):
     if "plan_ms" in result:
         print("\nGlobal planner (A*, nav_move_base.yaml's settings, the benchmark inputs, planning only, one thread)")
         print("  %-8s %20s %20s %12s %10s %9s" % ("grid", "one plan p50/p95 ms", "fastest of 5 ms", "mean cells",
-                                                "mean cost", "failures"))
+                                                  "mean cost", "failures"))
         for n, r in result["plan_ms"].items():
             s = result["plan_ms_single"][n]
             print("  %-8s %20s %20s %12.1f %10.1f %9d" % (

@@ -37,8 +37,8 @@ public:
       throw MapError(path_ + ": bad PGM header: expected " + what + " (a positive integer), got \"" + t + "\"");
     const unsigned long v = std::stoul(t);
     if (v == 0 || v > max_value)
-      throw MapError(path_ + ": bad PGM header: " + what + " must be in [1, " + std::to_string(max_value) +
-                     "], got " + t);
+      throw MapError(path_ + ": bad PGM header: " + what + " must be in [1, " + std::to_string(max_value) + "], got " +
+                     t);
     return static_cast<unsigned>(v);
   }
 
@@ -76,12 +76,9 @@ const char* mapModeName(MapMode mode)
 {
   switch (mode)
   {
-    case MapMode::SCALE:
-      return "scale";
-    case MapMode::RAW:
-      return "raw";
-    default:
-      return "trinary";
+    case MapMode::SCALE: return "scale";
+    case MapMode::RAW: return "raw";
+    default: return "trinary";
   }
 }
 
@@ -228,9 +225,8 @@ OccupancyMap loadMap(const std::string& yaml_path)
   for (unsigned j = 0; j < map.height; ++j)  // j: image row, top first
     for (unsigned i = 0; i < map.width; ++i)
       // Flip: image row 0 is the top, map row 0 is the bottom (at origin_y).
-      map.data[static_cast<size_t>(map.height - j - 1) * map.width + i] =
-          occupancyValue(pixels[static_cast<size_t>(j) * map.width + i], map.occupied_thresh, map.free_thresh,
-                         map.negate, map.mode);
+      map.data[static_cast<size_t>(map.height - j - 1) * map.width + i] = occupancyValue(
+          pixels[static_cast<size_t>(j) * map.width + i], map.occupied_thresh, map.free_thresh, map.negate, map.mode);
   return map;
 }
 

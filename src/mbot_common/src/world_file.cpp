@@ -113,7 +113,9 @@ std::string checkName(const std::string& name)
 {
   // A ROS graph name path without a leading slash: robot_3, fleet/robot_3 (tf2 rejects a
   // leading slash in frame ids).
-  auto bad = [&]() { return "expected a name of letters, digits and _ (not starting with a digit), got \"" + name + "\""; };
+  auto bad = [&]() {
+    return "expected a name of letters, digits and _ (not starting with a digit), got \"" + name + "\"";
+  };
   if (name.empty()) return bad();
   bool segment_start = true;
   for (const char c : name)
@@ -151,10 +153,10 @@ WorldConfig loadWorldConfig(const std::string& path)
 {
   const Reader r(path);
   const YAML::Node root = r.load();
-  r.checkKeys(root, "",
-              {"map", "physics_step", "real_time_factor", "seed", "robots", "obstacles", "moving_obstacles", "noise",
-               "faults"},
-              {"map"});
+  r.checkKeys(
+      root, "",
+      {"map", "physics_step", "real_time_factor", "seed", "robots", "obstacles", "moving_obstacles", "noise", "faults"},
+      {"map"});
 
   WorldConfig config;
   config.file = path;
@@ -168,8 +170,7 @@ WorldConfig loadWorldConfig(const std::string& path)
     if (config.physics_step > 0.1) r.expected("physics_step", "a number in (0, 0.1] [s]", root["physics_step"]);
   }
   if (root["real_time_factor"])
-    config.real_time_factor =
-        nonNegative(r, root["real_time_factor"], "real_time_factor", "(0 = as fast as possible)");
+    config.real_time_factor = nonNegative(r, root["real_time_factor"], "real_time_factor", "(0 = as fast as possible)");
   if (root["seed"])
   {
     const long long seed = r.integer(root["seed"], "seed", "an integer >= 0");
@@ -205,8 +206,8 @@ WorldConfig loadWorldConfig(const std::string& path)
     ObstacleConfig obstacle;
     obstacle.key = Reader::index("obstacles", i);
     r.checkKeys(item, obstacle.key, {"name", "shape", "size", "radius", "pose"}, {"shape", "pose"});
-    obstacle.name = item["name"] ? readName(r, item["name"], Reader::join(obstacle.key, "name"))
-                                 : "obstacle_" + std::to_string(i);
+    obstacle.name =
+        item["name"] ? readName(r, item["name"], Reader::join(obstacle.key, "name")) : "obstacle_" + std::to_string(i);
     claim(obstacle.name, Reader::join(obstacle.key, "name"));
     obstacle.shape = readShape(r, item, obstacle.key);
     obstacle.pose = readPose(r, item["pose"], Reader::join(obstacle.key, "pose"));
@@ -265,7 +266,8 @@ WorldConfig loadWorldConfig(const std::string& path)
   {
     const YAML::Node noise = root["noise"];
     r.checkKeys(noise, "noise", {"laser_range", "odom_linear", "odom_angular"});
-    if (noise["laser_range"]) config.noise.laser_range = nonNegative(r, noise["laser_range"], "noise.laser_range", "[m]");
+    if (noise["laser_range"])
+      config.noise.laser_range = nonNegative(r, noise["laser_range"], "noise.laser_range", "[m]");
     if (noise["odom_linear"])
       config.noise.odom_linear = nonNegative(r, noise["odom_linear"], "noise.odom_linear", "[m/s]");
     if (noise["odom_angular"])
@@ -301,7 +303,8 @@ WorldConfig loadWorldConfig(const std::string& path)
     if (item["drive_frozen"]) f.drive_frozen = r.boolean(item["drive_frozen"], Reader::join(fault.key, "drive_frozen"));
     if (item["silenced"]) f.silenced = r.boolean(item["silenced"], Reader::join(fault.key, "silenced"));
     const std::string problem = checkFaults(f);
-    if (!problem.empty()) r.fail(fault.key + "." + problem.substr(0, problem.find(':')), problem.substr(problem.find(':') + 2));
+    if (!problem.empty())
+      r.fail(fault.key + "." + problem.substr(0, problem.find(':')), problem.substr(problem.find(':') + 2));
     config.faults.push_back(fault);
   }
 

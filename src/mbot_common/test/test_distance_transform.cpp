@@ -63,7 +63,7 @@ TEST(SquaredDistanceTransform1d, MatchesBruteForceForIntsAndDoubles)
         const int c = std::min<int>(rng() % (2 * cap), cap);
         x = c * c;
       }
-      if (trial == 0) std::fill(fi.begin(), fi.end(), 0);        // all occupied
+      if (trial == 0) std::fill(fi.begin(), fi.end(), 0);          // all occupied
       if (trial == 1) std::fill(fi.begin(), fi.end(), cap * cap);  // nothing within the cap
       ASSERT_EQ(shared1d(fi), bruteForce1d(fi)) << "n " << n << " trial " << trial;
 
@@ -93,8 +93,7 @@ TEST(SquaredDistanceTransform1d, TwoPassesGiveTheExact2dTransform)
       squaredDistanceTransform1d(f.data(), g.h, d.data(), v.data(), z.data());
       for (int y = 0; y < g.h; ++y) cols[y * g.w + x] = d[y];
     }
-    for (int y = 0; y < g.h; ++y)
-      squaredDistanceTransform1d(&cols[y * g.w], g.w, &out[y * g.w], v.data(), z.data());
+    for (int y = 0; y < g.h; ++y) squaredDistanceTransform1d(&cols[y * g.w], g.w, &out[y * g.w], v.data(), z.data());
     const auto expected = bruteForceSquaredDistances(g);
     for (size_t i = 0; i < out.size(); ++i)
     {

@@ -107,8 +107,8 @@ TEST(MapIo, EachInvalidFixtureGivesItsMessage)
     {
       message = e.what();
     }
-    EXPECT_NE(message.find(c.expected), std::string::npos) << "fixture " << c.path << "\n  got:      " << message
-                                                           << "\n  expected: " << c.expected;
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "fixture " << c.path << "\n  got:      " << message << "\n  expected: " << c.expected;
     EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
   }
   std::string missing;

@@ -71,13 +71,17 @@ TEST(StrictYaml, KeysUnknownDuplicateMissing)
   const TempYaml file("rate: 1\nrat: 2\nrate: 3\n");
   const StrictYaml<> r(file.path());
   const YAML::Node root = r.load();
-  EXPECT_EQ(errorOf([&] { r.checkKeys(root, "", {"rate", "gain"}); }),
+  EXPECT_EQ(errorOf([&] {
+              r.checkKeys(root, "", {"rate", "gain"});
+            }),
             file.path() + ": rat: unknown key (expected one of rate, gain)");
   EXPECT_EQ(errorOf([&] { r.checkKeys(root, "", {"rate", "rat"}); }), file.path() + ": rate: duplicate key");
   const TempYaml nested("robots:\n  - name: a\n");
   const StrictYaml<> n(nested.path());
   const YAML::Node robots = n.load()["robots"];
-  EXPECT_EQ(errorOf([&] { n.checkKeys(robots[0], StrictYaml<>::index("robots", 0), {"name", "pose"}, {"pose"}); }),
+  EXPECT_EQ(errorOf([&] {
+              n.checkKeys(robots[0], StrictYaml<>::index("robots", 0), {"name", "pose"}, {"pose"});
+            }),
             nested.path() + ": robots[0].pose: missing key (required)");
 }
 

@@ -112,8 +112,8 @@ TEST(WorldFile, EachInvalidFixtureGivesItsMessage)
     {
       message = e.what();
     }
-    EXPECT_NE(message.find(c.expected), std::string::npos) << "fixture " << c.path << "\n  got:      " << message
-                                                           << "\n  expected: " << c.expected;
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "fixture " << c.path << "\n  got:      " << message << "\n  expected: " << c.expected;
     EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
   }
 }

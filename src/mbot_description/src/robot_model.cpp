@@ -21,8 +21,8 @@ namespace mbot_description
 namespace
 {
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kCircleVertices = 16;      // a cylinder body becomes a 16-gon, as costmap_2d does
-constexpr double kTolerance = 1e-6;      // [m] or [rad]: "equal" for numbers read from files
+constexpr int kCircleVertices = 16;        // a cylinder body becomes a 16-gon, as costmap_2d does
+constexpr double kTolerance = 1e-6;        // [m] or [rad]: "equal" for numbers read from files
 constexpr double kGroundTolerance = 1e-3;  // [m] a wheel centre may sit this far off its radius
 
 const char* const kRootLink = "base_footprint";
@@ -54,14 +54,13 @@ std::string formatNumber(double value)
 using SettingsReader = mbot_common::StrictYaml<ModelError>;
 
 /// The number at `map[key]`; `where` is the map's key path ("" at the top level).
-double number(const SettingsReader& reader, const YAML::Node& map, const std::string& where,
-              const std::string& key, const std::string& unit)
+double number(const SettingsReader& reader, const YAML::Node& map, const std::string& where, const std::string& key,
+              const std::string& unit)
 {
   return reader.number(map[key], SettingsReader::join(where, key), "a number " + unit);
 }
 
-int integer(const SettingsReader& reader, const YAML::Node& map, const std::string& where,
-            const std::string& key)
+int integer(const SettingsReader& reader, const YAML::Node& map, const std::string& where, const std::string& key)
 {
   const std::string path = SettingsReader::join(where, key);
   const long long value = reader.integer(map[key], path);
@@ -70,14 +69,12 @@ int integer(const SettingsReader& reader, const YAML::Node& map, const std::stri
   return static_cast<int>(value);
 }
 
-std::vector<std::string> textList(const SettingsReader& reader, const YAML::Node& map,
-                                  const std::string& key)
+std::vector<std::string> textList(const SettingsReader& reader, const YAML::Node& map, const std::string& key)
 {
   const YAML::Node node = map[key];
   if (!node.IsDefined() || !node.IsSequence()) reader.expected(key, "a list of strings", node);
   std::vector<std::string> values;
-  for (std::size_t i = 0; i < node.size(); ++i)
-    values.push_back(reader.text(node[i], SettingsReader::index(key, i)));
+  for (std::size_t i = 0; i < node.size(); ++i) values.push_back(reader.text(node[i], SettingsReader::index(key, i)));
   return values;
 }
 
@@ -93,11 +90,9 @@ RobotModel readSettings(const std::string& config_path)
 {
   const SettingsReader reader(config_path);
   const YAML::Node root = reader.load();
-  expectKeys(reader, root, "",
-             {"drive", "wheel_joints", "limits", "laser", "odom_rate", "ground_truth_rate"});
+  expectKeys(reader, root, "", {"drive", "wheel_joints", "limits", "laser", "odom_rate", "ground_truth_rate"});
   // Value checks: each names the key and the rule the value breaks.
-  const auto require = [&reader](bool ok, const std::string& key, const std::string& rule,
-                                 const YAML::Node& value) {
+  const auto require = [&reader](bool ok, const std::string& key, const std::string& rule, const YAML::Node& value) {
     if (!ok) reader.expected(key, rule, value);
   };
 
@@ -110,13 +105,12 @@ RobotModel readSettings(const std::string& config_path)
   model.wheel_joints = textList(reader, root, "wheel_joints");
   const std::size_t wheels = diff ? 2 : 4;
   if (model.wheel_joints.size() != wheels)
-    reader.fail("wheel_joints", "expected " + std::to_string(wheels) + " joint names for drive " +
-                                    drive + ", got " + std::to_string(model.wheel_joints.size()));
+    reader.fail("wheel_joints", "expected " + std::to_string(wheels) + " joint names for drive " + drive + ", got " +
+                                    std::to_string(model.wheel_joints.size()));
 
   const YAML::Node limits = root["limits"];
   expectKeys(reader, limits, "limits",
-             {"max_vel_x", "min_vel_x", "max_vel_y", "max_vel_theta", "acc_lim_x", "acc_lim_y",
-              "acc_lim_theta"});
+             {"max_vel_x", "min_vel_x", "max_vel_y", "max_vel_theta", "acc_lim_x", "acc_lim_y", "acc_lim_theta"});
   Limits& lim = model.limits;
   lim.max_vel_x = number(reader, limits, "limits", "max_vel_x", "[m/s]");
   lim.min_vel_x = number(reader, limits, "limits", "min_vel_x", "[m/s]");
@@ -132,14 +126,11 @@ RobotModel readSettings(const std::string& config_path)
   require(lim.acc_lim_theta > 0.0, "limits.acc_lim_theta", "> 0", limits["acc_lim_theta"]);
   // A differential drive cannot move sideways: a non-zero value there is a copy-paste slip.
   const std::string sideways = diff ? "0 for drive diff" : "> 0 for drive omni";
-  require(diff ? lim.max_vel_y == 0.0 : lim.max_vel_y > 0.0, "limits.max_vel_y", sideways,
-          limits["max_vel_y"]);
-  require(diff ? lim.acc_lim_y == 0.0 : lim.acc_lim_y > 0.0, "limits.acc_lim_y", sideways,
-          limits["acc_lim_y"]);
+  require(diff ? lim.max_vel_y == 0.0 : lim.max_vel_y > 0.0, "limits.max_vel_y", sideways, limits["max_vel_y"]);
+  require(diff ? lim.acc_lim_y == 0.0 : lim.acc_lim_y > 0.0, "limits.acc_lim_y", sideways, limits["acc_lim_y"]);
 
   const YAML::Node laser = root["laser"];
-  expectKeys(reader, laser, "laser",
-             {"beams", "min_angle", "max_angle", "range_min", "range_max", "rate"});
+  expectKeys(reader, laser, "laser", {"beams", "min_angle", "max_angle", "range_min", "range_max", "rate"});
   LaserSpec& spec = model.laser;
   spec.beams = integer(reader, laser, "laser", "beams");
   spec.min_angle = number(reader, laser, "laser", "min_angle", "[rad]");
@@ -149,8 +140,8 @@ RobotModel readSettings(const std::string& config_path)
   spec.rate = number(reader, laser, "laser", "rate", "[Hz]");
   require(spec.beams >= 1, "laser.beams", ">= 1", laser["beams"]);
   require(spec.max_angle > spec.min_angle, "laser.max_angle", "> min_angle", laser["max_angle"]);
-  require(spec.max_angle - spec.min_angle <= 2.0 * kPi + kTolerance, "laser.max_angle",
-          "max_angle - min_angle <= 2 pi", laser["max_angle"]);
+  require(spec.max_angle - spec.min_angle <= 2.0 * kPi + kTolerance, "laser.max_angle", "max_angle - min_angle <= 2 pi",
+          laser["max_angle"]);
   require(spec.range_min > 0.0, "laser.range_min", "> 0", laser["range_min"]);
   require(spec.range_max > spec.range_min, "laser.range_max", "> range_min", laser["range_max"]);
   require(spec.rate > 0.0, "laser.rate", "> 0", laser["rate"]);
@@ -172,8 +163,7 @@ urdf::Pose compose(const urdf::Pose& a, const urdf::Pose& b)
   // (urdfdom's Vector3::operator+ is not const, hence the spelled-out sum)
   urdf::Pose out;
   const urdf::Vector3 moved = a.rotation * b.position;
-  out.position =
-      urdf::Vector3(a.position.x + moved.x, a.position.y + moved.y, a.position.z + moved.z);
+  out.position = urdf::Vector3(a.position.x + moved.x, a.position.y + moved.y, a.position.z + moved.z);
   out.rotation = a.rotation * b.rotation;
   out.rotation.normalize();
   return out;
@@ -194,12 +184,10 @@ public:
   {
     const std::string xml = readFile(file_, "URDF");
     model_ = urdf::parseURDF(xml);
-    if (!model_)
-      throw ModelError(file_ + ": not a valid URDF (urdfdom's message is printed above)");
+    if (!model_) throw ModelError(file_ + ": not a valid URDF (urdfdom's message is printed above)");
     const urdf::LinkConstSharedPtr root = model_->getRoot();
     if (!root || root->name != kRootLink)
-      fail("root link",
-           std::string("expected ") + kRootLink + ", got " + (root ? root->name : "none"));
+      fail("root link", std::string("expected ") + kRootLink + ", got " + (root ? root->name : "none"));
   }
 
   [[noreturn]] void fail(const std::string& key, const std::string& message) const
@@ -267,8 +255,7 @@ void readFootprint(const UrdfReader& urdf, RobotModel& model)
 {
   const auto [geometry, pose] = urdf.collision(kBodyLink);
   const std::string key = std::string("link ") + kBodyLink + " collision";
-  if (!isUpright(pose.rotation))
-    urdf.fail(key, "expected an upright body (roll = pitch = 0) for a planar footprint");
+  if (!isUpright(pose.rotation)) urdf.fail(key, "expected an upright body (roll = pitch = 0) for a planar footprint");
 
   const double cx = pose.position.x;
   const double cy = pose.position.y;
@@ -315,8 +302,8 @@ void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotMod
     const std::string& name = model.wheel_joints[i];
     const urdf::JointConstSharedPtr joint = urdf.model().getJoint(name);
     if (!joint)
-      throw ModelError(config_path + ": wheel_joints[" + std::to_string(i) +
-                       "]: no joint named " + name + " in " + urdf.file());
+      throw ModelError(config_path + ": wheel_joints[" + std::to_string(i) + "]: no joint named " + name + " in " +
+                       urdf.file());
     if (joint->type != urdf::Joint::CONTINUOUS && joint->type != urdf::Joint::REVOLUTE)
       urdf.fail("joint " + name, "expected a continuous joint for a wheel");
 
@@ -327,21 +314,18 @@ void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotMod
     else if (geometry->type == urdf::Geometry::SPHERE)
       radius = static_cast<const urdf::Sphere&>(*geometry).radius;
     else
-      urdf.fail("link " + joint->child_link_name + " collision",
-                "expected a cylinder or a sphere wheel");
+      urdf.fail("link " + joint->child_link_name + " collision", "expected a cylinder or a sphere wheel");
     if (i > 0 && std::abs(radius - model.wheel_radius) > kTolerance)
-      urdf.fail("link " + joint->child_link_name + " collision",
-                "expected the same radius as the other wheels (" +
-                    formatNumber(model.wheel_radius) + " m), got " + formatNumber(radius));
+      urdf.fail("link " + joint->child_link_name + " collision", "expected the same radius as the other wheels (" +
+                                                                     formatNumber(model.wheel_radius) + " m), got " +
+                                                                     formatNumber(radius));
     model.wheel_radius = radius;
 
     // The wheel's axle is the joint frame, which is also the wheel link frame.
     const urdf::Vector3 axle = urdf.linkPose(joint->child_link_name).pose.position;
     if (std::abs(axle.z - radius) > kGroundTolerance)
-      urdf.fail("joint " + name, "expected the axle at wheel-radius height " +
-                                     formatNumber(radius) +
-                                     " m so the wheel touches the ground, got z = " +
-                                     formatNumber(axle.z));
+      urdf.fail("joint " + name, "expected the axle at wheel-radius height " + formatNumber(radius) +
+                                     " m so the wheel touches the ground, got z = " + formatNumber(axle.z));
     min_x = i == 0 ? axle.x : std::min(min_x, axle.x);
     max_x = i == 0 ? axle.x : std::max(max_x, axle.x);
     min_y = i == 0 ? axle.y : std::min(min_y, axle.y);
@@ -352,15 +336,15 @@ void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotMod
   if (model.wheel_separation < kTolerance)
     throw ModelError(config_path +
                      ": wheel_joints: expected wheels on both sides (left and right), but they "
-                     "all sit at y = " + formatNumber(min_y));
+                     "all sit at y = " +
+                     formatNumber(min_y));
 }
 
 void readLaserMount(const UrdfReader& urdf, RobotModel& model)
 {
   const LinkPose mount = urdf.linkPose(kLaserLink);
   if (!mount.rigid)
-    urdf.fail(std::string("link ") + kLaserLink,
-              "expected a chain of fixed joints from base_footprint");
+    urdf.fail(std::string("link ") + kLaserLink, "expected a chain of fixed joints from base_footprint");
   if (!isUpright(mount.pose.rotation))
     urdf.fail(std::string("link ") + kLaserLink, "expected a level laser (roll = pitch = 0)");
   model.laser.mount_x = mount.pose.position.x;
@@ -393,10 +377,9 @@ RobotModel loadRobotModelFiles(const std::string& urdf_path, const std::string& 
 
 RobotModel loadRobotModel(const std::string& description_dir, const std::string& model)
 {
-  if (model.empty())
-    throw ModelError(description_dir + ": model: expected a model name such as mbot");
-  RobotModel out = loadRobotModelFiles(description_dir + "/urdf/" + model + ".urdf",
-                                       description_dir + "/config/" + model + ".yaml");
+  if (model.empty()) throw ModelError(description_dir + ": model: expected a model name such as mbot");
+  RobotModel out =
+      loadRobotModelFiles(description_dir + "/urdf/" + model + ".urdf", description_dir + "/config/" + model + ".yaml");
   out.name = model;
   return out;
 }

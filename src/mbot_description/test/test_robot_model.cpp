@@ -62,8 +62,7 @@ void expectMentions(const std::string& message, const std::vector<std::string>& 
 {
   ASSERT_FALSE(message.empty()) << "expected a ModelError";
   for (const auto& part : parts)
-    EXPECT_NE(message.find(part), std::string::npos)
-        << "\"" << message << "\" does not mention \"" << part << "\"";
+    EXPECT_NE(message.find(part), std::string::npos) << "\"" << message << "\" does not mention \"" << part << "\"";
 }
 }  // namespace
 
@@ -137,8 +136,7 @@ TEST(RobotModel, MbotOmniMatchesItsUrdf)
 
 TEST(RobotModel, ComposesTheJointChain)
 {
-  const RobotModel m =
-      loadRobotModelFiles(fixture("valid_offset.urdf"), fixture("valid_offset.yaml"));
+  const RobotModel m = loadRobotModelFiles(fixture("valid_offset.urdf"), fixture("valid_offset.yaml"));
   EXPECT_EQ(m.name, "offset_bot");
 
   // Box 0.4 x 0.2 turned +90 deg and shifted 0.1 m forward: x in [0, 0.2], y in [-0.2, 0.2].
@@ -199,8 +197,7 @@ TEST(RobotModelErrors, WrongType)
   expectMentions(fixtureError("valid_offset.urdf", "invalid_wrong_type.yaml"),
                  {"invalid_wrong_type.yaml", "laser.beams", "expected an integer", "\"many\""});
   expectMentions(fixtureError("valid_offset.urdf", "invalid_quoted_number.yaml"),
-                 {"invalid_quoted_number.yaml", "limits.max_vel_x", "expected a number [m/s]",
-                  "\"0.7\""});
+                 {"invalid_quoted_number.yaml", "limits.max_vel_x", "expected a number [m/s]", "\"0.7\""});
   expectMentions(fixtureError("valid_offset.urdf", "invalid_drive.yaml"),
                  {"invalid_drive.yaml", "drive", "expected diff or omni", "\"tank\""});
 }
@@ -214,8 +211,7 @@ TEST(RobotModelErrors, MissingKey)
 TEST(RobotModelErrors, WheelJointNotInUrdf)
 {
   expectMentions(fixtureError("valid_offset.urdf", "invalid_wheel_joint.yaml"),
-                 {"invalid_wheel_joint.yaml", "wheel_joints[1]", "wheel_c_joint",
-                  "valid_offset.urdf"});
+                 {"invalid_wheel_joint.yaml", "wheel_joints[1]", "wheel_c_joint", "valid_offset.urdf"});
 }
 
 TEST(RobotModelErrors, UrdfWithoutBaseLink)

@@ -40,8 +40,9 @@ public:
     transform_tolerance_ = ros::Duration(params.getDouble("transform_tolerance", 0.1));
     params.checkNoUnknown();
     if (!ros::Time::isSimTime())
-      throw std::runtime_error("fake_localization needs /use_sim_time true: it reads the "
-                               "simulator's ground truth, which only exists in simulation");
+      throw std::runtime_error(
+          "fake_localization needs /use_sim_time true: it reads the "
+          "simulator's ground truth, which only exists in simulation");
 
     pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
     cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);

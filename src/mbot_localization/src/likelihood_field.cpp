@@ -15,8 +15,7 @@ namespace
 constexpr double FAR = 1e20;
 }  // namespace
 
-std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width,
-                                             unsigned height)
+std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width, unsigned height)
 {
   std::vector<double> grid(occupied.size());
   for (size_t i = 0; i < occupied.size(); ++i) grid[i] = occupied[i] ? 0.0 : FAR;
@@ -44,17 +43,20 @@ std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupie
 }
 
 LikelihoodField::LikelihoodField(const OccupancyGridData& grid, double max_distance)
-  : width_(grid.width), height_(grid.height), resolution_(grid.resolution),
-    origin_x_(grid.origin_x), origin_y_(grid.origin_y), max_distance_(max_distance)
+    : width_(grid.width),
+      height_(grid.height),
+      resolution_(grid.resolution),
+      origin_x_(grid.origin_x),
+      origin_y_(grid.origin_y),
+      max_distance_(max_distance)
 {
   const size_t cells = static_cast<size_t>(width_) * height_;
   if (grid.data.size() != cells)
     throw std::invalid_argument("likelihood field: the map is " + std::to_string(width_) + " x " +
-                                std::to_string(height_) + " cells but has " +
-                                std::to_string(grid.data.size()) + " values");
+                                std::to_string(height_) + " cells but has " + std::to_string(grid.data.size()) +
+                                " values");
   if (!(resolution_ > 0.0))
-    throw std::invalid_argument("likelihood field: resolution must be > 0, got " +
-                                std::to_string(resolution_));
+    throw std::invalid_argument("likelihood field: resolution must be > 0, got " + std::to_string(resolution_));
   if (!(max_distance_ > 0.0))
     throw std::invalid_argument("likelihood field: laser_likelihood_max_dist must be > 0, got " +
                                 std::to_string(max_distance_));

@@ -10,17 +10,16 @@ namespace mbot_localization
 // ---------------------------------------------------------------- particle filter localizer
 
 PfLocalizer::PfLocalizer(const PfLocalizerConfig& config, const OccupancyGridData& map, uint32_t seed)
-  : config_(config),
-    field_(std::make_shared<LikelihoodField>(map, config.likelihood_max_dist)),
-    filter_(config.filter, seed),
-    motion_(config.motion),
-    laser_(config.laser, field_)
+    : config_(config),
+      field_(std::make_shared<LikelihoodField>(map, config.likelihood_max_dist)),
+      filter_(config.filter, seed),
+      motion_(config.motion),
+      laser_(config.laser, field_)
 {
   if (!(config_.update_min_d >= 0.0) || !(config_.update_min_a >= 0.0))
     throw std::invalid_argument("update_min_d, update_min_a: expected >= 0");
   if (config_.resample_interval < 1)
-    throw std::invalid_argument("resample_interval: expected >= 1, got " +
-                                std::to_string(config_.resample_interval));
+    throw std::invalid_argument("resample_interval: expected >= 1, got " + std::to_string(config_.resample_interval));
 }
 
 void validateConfig(const PfLocalizerConfig& config)
@@ -45,8 +44,7 @@ void PfLocalizer::setInitialPose(const Pose2D& pose, const std::array<double, 9>
   force_update_ = true;
 }
 
-bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan,
-                              const Pose2D& laser_in_base)
+bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan, const Pose2D& laser_in_base)
 {
   if (!initialized_) return false;
 
@@ -76,14 +74,13 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
 // ---------------------------------------------------------------- fake localization
 
 GroundTruthMatcher::GroundTruthMatcher(int64_t buffer_ns, int64_t match_tolerance_ns)
-  : buffer_ns_(buffer_ns), tolerance_ns_(match_tolerance_ns)
+    : buffer_ns_(buffer_ns), tolerance_ns_(match_tolerance_ns)
 {
   if (buffer_ns_ <= 0 || tolerance_ns_ < 0)
     throw std::invalid_argument("ground truth matcher: expected buffer > 0 and tolerance >= 0");
 }
 
-void GroundTruthMatcher::append(std::deque<StampedPose>& samples, int64_t& last_stamp_ns,
-                                const StampedPose& sample)
+void GroundTruthMatcher::append(std::deque<StampedPose>& samples, int64_t& last_stamp_ns, const StampedPose& sample)
 {
   // One publisher's messages arrive in order, so an older stamp means that time jumped back
   // (the simulation was reset): everything buffered belongs to the old timeline.
@@ -118,12 +115,12 @@ std::optional<Pose2D> GroundTruthMatcher::groundTruthAt(int64_t stamp_ns) const
 {
   auto after = std::lower_bound(truth_.begin(), truth_.end(), stamp_ns - tolerance_ns_,
                                 [](const StampedPose& a, int64_t t) { return a.stamp_ns < t; });
-  if (after == truth_.end()) return std::nullopt;  // not received yet
+  if (after == truth_.end()) return std::nullopt;                       // not received yet
   if (after->stamp_ns <= stamp_ns + tolerance_ns_) return after->pose;  // same stamp
-  if (after == truth_.begin()) return std::nullopt;  // older than everything we have
+  if (after == truth_.begin()) return std::nullopt;                     // older than everything we have
   const StampedPose& before = *(after - 1);
-  const double ratio = static_cast<double>(stamp_ns - before.stamp_ns) /
-                       static_cast<double>(after->stamp_ns - before.stamp_ns);
+  const double ratio =
+      static_cast<double>(stamp_ns - before.stamp_ns) / static_cast<double>(after->stamp_ns - before.stamp_ns);
   Pose2D p;
   p.x = before.pose.x + ratio * (after->pose.x - before.pose.x);
   p.y = before.pose.y + ratio * (after->pose.y - before.pose.y);

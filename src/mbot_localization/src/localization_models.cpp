@@ -24,8 +24,8 @@ OdomMotionModel::OdomMotionModel(const MotionModelConfig& config) : config_(conf
                                   std::to_string(alphas[i]));
 }
 
-void OdomMotionModel::apply(const Pose2D& odom_old, const Pose2D& odom_new,
-                            std::vector<Particle>& particles, std::mt19937& rng) const
+void OdomMotionModel::apply(const Pose2D& odom_old, const Pose2D& odom_new, std::vector<Particle>& particles,
+                            std::mt19937& rng) const
 {
   if (config_.type == OdomModelType::DIFF)
     applyDiff(odom_old, odom_new, particles, rng);
@@ -44,8 +44,8 @@ double gaussian(double sigma, std::mt19937& rng)
 }
 }  // namespace
 
-void OdomMotionModel::applyDiff(const Pose2D& odom_old, const Pose2D& odom_new,
-                                std::vector<Particle>& particles, std::mt19937& rng) const
+void OdomMotionModel::applyDiff(const Pose2D& odom_old, const Pose2D& odom_new, std::vector<Particle>& particles,
+                                std::mt19937& rng) const
 {
   // The odometry motion as rotate (rot1), translate (trans), rotate (rot2), in the old pose.
   const double dx = odom_new.x - odom_old.x;
@@ -63,8 +63,8 @@ void OdomMotionModel::applyDiff(const Pose2D& odom_old, const Pose2D& odom_new,
   const double rot2_size = rotation_size(short_move ? angleDiff(odom_new.theta, odom_old.theta) : rot2);
   const MotionModelConfig& a = config_;
   const double sigma_rot1 = std::sqrt(a.alpha1 * rot1_size * rot1_size + a.alpha2 * trans * trans);
-  const double sigma_trans = std::sqrt(a.alpha3 * trans * trans + a.alpha4 * rot1_size * rot1_size +
-                                       a.alpha4 * rot2_size * rot2_size);
+  const double sigma_trans =
+      std::sqrt(a.alpha3 * trans * trans + a.alpha4 * rot1_size * rot1_size + a.alpha4 * rot2_size * rot2_size);
   const double sigma_rot2 = std::sqrt(a.alpha1 * rot2_size * rot2_size + a.alpha2 * trans * trans);
 
   for (Particle& p : particles)
@@ -78,8 +78,8 @@ void OdomMotionModel::applyDiff(const Pose2D& odom_old, const Pose2D& odom_new,
   }
 }
 
-void OdomMotionModel::applyOmni(const Pose2D& odom_old, const Pose2D& odom_new,
-                                std::vector<Particle>& particles, std::mt19937& rng) const
+void OdomMotionModel::applyOmni(const Pose2D& odom_old, const Pose2D& odom_new, std::vector<Particle>& particles,
+                                std::mt19937& rng) const
 {
   // The odometry motion as a translation along a bearing (relative to the old heading) and a
   // rotation; the robot may also slip sideways (strafe).
@@ -109,9 +109,8 @@ void OdomMotionModel::applyOmni(const Pose2D& odom_old, const Pose2D& odom_new,
 
 // ---------------------------------------------------------------- likelihood-field laser model
 
-LikelihoodFieldModel::LikelihoodFieldModel(const LaserModelConfig& config,
-                                           std::shared_ptr<const LikelihoodField> field)
-  : config_(config), field_(std::move(field))
+LikelihoodFieldModel::LikelihoodFieldModel(const LaserModelConfig& config, std::shared_ptr<const LikelihoodField> field)
+    : config_(config), field_(std::move(field))
 {
   if (!field_) throw std::invalid_argument("likelihood field model: no map (null field)");
   if (!(config_.sigma_hit > 0.0))
@@ -134,8 +133,7 @@ struct Beam
 
 /// The usable beams of a scan, thinned to at most `max_beams` evenly spread ones (as amcl:
 /// every step-th beam). Beams without a valid return are left out.
-std::vector<Beam> selectBeams(const LaserScanData& scan, const LaserModelConfig& config,
-                              double& range_max)
+std::vector<Beam> selectBeams(const LaserScanData& scan, const LaserModelConfig& config, double& range_max)
 {
   range_max = config.max_range > 0.0 ? config.max_range : scan.range_max;
   const double range_min = config.min_range > 0.0 ? config.min_range : scan.range_min;

@@ -28,11 +28,10 @@ OccupancyGridData toOccupancyGridData(const nav_msgs::OccupancyGrid& grid)
   out.origin_x = grid.info.origin.position.x;
   out.origin_y = grid.info.origin.position.y;
   if (grid.data.size() != static_cast<size_t>(out.width) * out.height)
-    throw std::runtime_error("map: " + std::to_string(out.width) + " x " + std::to_string(out.height) +
-                             " cells but " + std::to_string(grid.data.size()) + " values");
+    throw std::runtime_error("map: " + std::to_string(out.width) + " x " + std::to_string(out.height) + " cells but " +
+                             std::to_string(grid.data.size()) + " values");
   if (std::fabs(tf2::getYaw(grid.info.origin.orientation)) > 1e-6)
-    throw std::runtime_error("map: a rotated origin (yaw " +
-                             std::to_string(tf2::getYaw(grid.info.origin.orientation)) +
+    throw std::runtime_error("map: a rotated origin (yaw " + std::to_string(tf2::getYaw(grid.info.origin.orientation)) +
                              " rad) is not supported; rotate the image instead");
   out.data = grid.data;
   return out;

@@ -8,8 +8,7 @@
 
 namespace mbot_localization
 {
-std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count,
-                                      std::mt19937& rng)
+std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count, std::mt19937& rng)
 {
   std::vector<size_t> picked;
   if (weights.empty() || count == 0) return picked;
@@ -30,16 +29,15 @@ std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t
   return picked;
 }
 
-ParticleFilter::ParticleFilter(const ParticleFilterConfig& config, uint32_t seed)
-  : config_(config), rng_(seed)
+ParticleFilter::ParticleFilter(const ParticleFilterConfig& config, uint32_t seed) : config_(config), rng_(seed)
 {
   if (config_.min_particles < 1 || config_.max_particles < config_.min_particles)
-    throw std::invalid_argument("min_particles, max_particles: expected 1 <= min_particles <= "
-                                "max_particles, got " + std::to_string(config_.min_particles) +
-                                ", " + std::to_string(config_.max_particles));
+    throw std::invalid_argument(
+        "min_particles, max_particles: expected 1 <= min_particles <= "
+        "max_particles, got " +
+        std::to_string(config_.min_particles) + ", " + std::to_string(config_.max_particles));
   if (config_.particles_per_bin < 1)
-    throw std::invalid_argument("particles_per_bin: expected >= 1, got " +
-                                std::to_string(config_.particles_per_bin));
+    throw std::invalid_argument("particles_per_bin: expected >= 1, got " + std::to_string(config_.particles_per_bin));
   if (!(config_.bin_size_xy > 0.0) || !(config_.bin_size_theta > 0.0))
     throw std::invalid_argument("bin sizes: expected > 0");
 }
@@ -66,8 +64,7 @@ void ParticleFilter::normalizeWeights()
   double total = 0.0;
   for (const Particle& p : particles_) total += p.weight;
   const bool usable = total > 0.0 && std::isfinite(total);
-  for (Particle& p : particles_)
-    p.weight = usable ? p.weight / total : 1.0 / static_cast<double>(particles_.size());
+  for (Particle& p : particles_) p.weight = usable ? p.weight / total : 1.0 / static_cast<double>(particles_.size());
 }
 
 size_t ParticleFilter::countBins(const std::vector<size_t>& indices) const
@@ -103,8 +100,8 @@ void ParticleFilter::resample()
   // Draw at the current size, measure how spread the drawn set is, and redraw at the size that
   // this spread needs (see ParticleFilterConfig).
   std::vector<size_t> picked = lowVarianceSample(weights, particles_.size(), rng_);
-  const size_t wanted = std::clamp<size_t>(countBins(picked) * config_.particles_per_bin,
-                                           config_.min_particles, config_.max_particles);
+  const size_t wanted =
+      std::clamp<size_t>(countBins(picked) * config_.particles_per_bin, config_.min_particles, config_.max_particles);
   if (wanted != picked.size()) picked = lowVarianceSample(weights, wanted, rng_);
 
   std::vector<Particle> next(picked.size());

@@ -43,9 +43,8 @@ public:
     map_sub_ = nh.subscribe("/map", 1, &PfLocalizationNode::onMap, this);
     scan_sub_ = nh.subscribe("scan", 5, &PfLocalizationNode::onScan, this);
     initial_pose_sub_ = nh.subscribe("initialpose", 2, &PfLocalizationNode::onInitialPose, this);
-    ROS_INFO("pf_localization: %s -> %s from %s, %d..%d particles, seed %u", global_frame_.c_str(),
-             odom_frame_.c_str(), scan_sub_.getTopic().c_str(), config_.filter.min_particles,
-             config_.filter.max_particles, seed_);
+    ROS_INFO("pf_localization: %s -> %s from %s, %d..%d particles, seed %u", global_frame_.c_str(), odom_frame_.c_str(),
+             scan_sub_.getTopic().c_str(), config_.filter.min_particles, config_.filter.max_particles, seed_);
   }
 
 private:
@@ -114,9 +113,8 @@ private:
       }
       else
         localizer_->setMap(map);
-      ROS_INFO("pf_localization: map %u x %u at %.3f m/cell; initial pose (%.2f, %.2f, %.2f)",
-               map.width, map.height, map.resolution, initial_pose_.x, initial_pose_.y,
-               initial_pose_.theta);
+      ROS_INFO("pf_localization: map %u x %u at %.3f m/cell; initial pose (%.2f, %.2f, %.2f)", map.width, map.height,
+               map.resolution, initial_pose_.x, initial_pose_.y, initial_pose_.theta);
     }
     catch (const std::exception& e)
     {
@@ -137,8 +135,7 @@ private:
     initial_cov_[0] = msg.pose.covariance[0];   // xx
     initial_cov_[4] = msg.pose.covariance[7];   // yy
     initial_cov_[8] = msg.pose.covariance[35];  // yaw-yaw
-    ROS_INFO("pf_localization: initial pose (%.2f, %.2f, %.2f)", initial_pose_.x, initial_pose_.y,
-             initial_pose_.theta);
+    ROS_INFO("pf_localization: initial pose (%.2f, %.2f, %.2f)", initial_pose_.x, initial_pose_.y, initial_pose_.theta);
     if (localizer_) localizer_->setInitialPose(initial_pose_, initial_cov_);
   }
 
@@ -157,8 +154,8 @@ private:
           tf_buffer_.lookupTransform(base_frame_, laser_frame, ros::Time(0), ros::Duration(0.5));
       mount = toPose2D(t.transform);
       mounts_[laser_frame] = mount;
-      ROS_INFO("pf_localization: laser %s at (%.3f, %.3f, %.3f) in %s", laser_frame.c_str(), mount.x,
-               mount.y, mount.theta, base_frame_.c_str());
+      ROS_INFO("pf_localization: laser %s at (%.3f, %.3f, %.3f) in %s", laser_frame.c_str(), mount.x, mount.y,
+               mount.theta, base_frame_.c_str());
       return true;
     }
     catch (const tf2::TransformException& e)
@@ -179,8 +176,8 @@ private:
     if (!laserMount(msg.header.frame_id, mount)) return;
     try
     {
-      odom = toPose2D(tf_buffer_.lookupTransform(odom_frame_, base_frame_, msg.header.stamp,
-                                                 ros::Duration(0.2)).transform);
+      odom = toPose2D(
+          tf_buffer_.lookupTransform(odom_frame_, base_frame_, msg.header.stamp, ros::Duration(0.2)).transform);
     }
     catch (const tf2::TransformException& e)
     {

@@ -49,7 +49,6 @@ def homogeneous(x, y, z, q):
     return m
 
 
-
 def ground_truth(k):
     """The robot in the map: drives and turns across the +-pi seam."""
     return 2.0 + 0.05 * k, -1.0 + 0.002 * k * k, 2.8 + 0.05 * k

@@ -54,8 +54,8 @@ OccupancyGridData makeRoom()
   g.origin_x = -0.5;  // a non-zero origin, so that map/world conversions are exercised
   g.origin_y = -0.25;
   g.data.assign(g.width * g.height, 0);
-  const double x_max = g.origin_x + g.width * g.resolution;   // 9.5
-  const double y_max = g.origin_y + g.height * g.resolution;  // 7.75
+  const double x_max = g.origin_x + g.width * g.resolution;    // 9.5
+  const double y_max = g.origin_y + g.height * g.resolution;   // 7.75
   addBox(g, g.origin_x, g.origin_y, x_max, g.origin_y + 0.1);  // outer walls
   addBox(g, g.origin_x, y_max - 0.1, x_max, y_max);
   addBox(g, g.origin_x, g.origin_y, g.origin_x + 0.1, y_max);
@@ -79,8 +79,8 @@ bool occupiedAt(const OccupancyGridData& g, double x, double y)
 }
 
 /// A laser simulated by marching along each beam in 5 mm steps, with Gaussian range noise.
-LaserScanData simulateScan(const OccupancyGridData& g, const Pose2D& laser, int beams,
-                           double range_max, double noise, std::mt19937& rng)
+LaserScanData simulateScan(const OccupancyGridData& g, const Pose2D& laser, int beams, double range_max, double noise,
+                           std::mt19937& rng)
 {
   LaserScanData scan;
   scan.angle_min = -M_PI;
@@ -185,10 +185,11 @@ TEST(OdomMotionModel, ZeroNoiseMovesParticlesExactly)
     const OdomMotionModel model(config);
     std::mt19937 rng(1);
     // forward, sideways (omni), backwards, pure rotation, and a move across the +-pi seam
-    const std::vector<std::pair<Pose2D, Pose2D>> moves = {
-        {pose(0.0, 0.0, 0.0), pose(0.5, 0.1, 0.3)},   {pose(1.0, 2.0, 1.0), pose(0.8, 2.3, 1.2)},
-        {pose(1.0, 1.0, 0.5), pose(0.7, 0.85, 0.45)}, {pose(3.0, -1.0, 2.0), pose(3.0, -1.0, -2.5)},
-        {pose(0.0, 0.0, 3.1), pose(-0.2, 0.01, -3.1)}};
+    const std::vector<std::pair<Pose2D, Pose2D>> moves = {{pose(0.0, 0.0, 0.0), pose(0.5, 0.1, 0.3)},
+                                                          {pose(1.0, 2.0, 1.0), pose(0.8, 2.3, 1.2)},
+                                                          {pose(1.0, 1.0, 0.5), pose(0.7, 0.85, 0.45)},
+                                                          {pose(3.0, -1.0, 2.0), pose(3.0, -1.0, -2.5)},
+                                                          {pose(0.0, 0.0, 3.1), pose(-0.2, 0.01, -3.1)}};
     for (const auto& move : moves)
     {
       std::vector<Particle> particles = {{pose(2.0, 3.0, -0.7), 1.0}, {pose(-1.0, 0.5, 3.0), 1.0}};
@@ -340,7 +341,7 @@ struct RunResult
   double worst_position_error = 0.0;  ///< over all updates after SETTLE_UPDATES [m]
   double worst_heading_error = 0.0;   ///< [rad]
   int updates = 0;
-  size_t particles = 0;               ///< in the final set
+  size_t particles = 0;  ///< in the final set
 };
 
 /// Drive a robot through the room with noisy odometry and simulated scans; the filter starts
@@ -371,8 +372,8 @@ RunResult runFilter(uint32_t seed, OdomModelType type)
   const Pose2D guess = pose(truth.x + 0.25, truth.y - 0.17, truth.theta + 0.2);
   localizer.setInitialPose(guess, cov);
 
-  const std::vector<std::pair<double, double>> waypoints = {
-      {2.0, 4.5}, {5.0, 4.2}, {5.0, 1.0}, {8.5, 1.0}, {8.5, 3.8}, {5.0, 4.2}};
+  const std::vector<std::pair<double, double>> waypoints = {{2.0, 4.5}, {5.0, 4.2}, {5.0, 1.0},
+                                                            {8.5, 1.0}, {8.5, 3.8}, {5.0, 4.2}};
   RunResult result;
   result.initial_error = std::hypot(guess.x - truth.x, guess.y - truth.y);
   size_t next = 0;
@@ -424,10 +425,11 @@ RunResult runFilter(uint32_t seed, OdomModelType type)
 
 void expectConverged(const RunResult& r, const char* model, uint32_t seed)
 {
-  std::printf("[ %s seed %u ] %d updates, initial error %.3f m; after %d updates worst error "
-              "%.3f m %.3f rad; final %.3f m %.3f rad, %zu particles\n",
-              model, seed, r.updates, r.initial_error, SETTLE_UPDATES, r.worst_position_error,
-              r.worst_heading_error, r.position_error, r.heading_error, r.particles);
+  std::printf(
+      "[ %s seed %u ] %d updates, initial error %.3f m; after %d updates worst error "
+      "%.3f m %.3f rad; final %.3f m %.3f rad, %zu particles\n",
+      model, seed, r.updates, r.initial_error, SETTLE_UPDATES, r.worst_position_error, r.worst_heading_error,
+      r.position_error, r.heading_error, r.particles);
   EXPECT_GT(r.initial_error, 0.2);  // the filter has something to correct
   EXPECT_GT(r.updates, 4 * SETTLE_UPDATES);
   EXPECT_LT(r.worst_position_error, 0.1) << model << " seed " << seed;
@@ -468,10 +470,10 @@ TEST(PfLocalizer, UpdatesOnlyAfterEnoughMotion)
   cov[0] = cov[4] = 0.01;
   cov[8] = 0.01;
   localizer.setInitialPose(pose(2, 4, 0), cov);
-  EXPECT_TRUE(localizer.processScan(pose(0, 0, 0), scan, mount));     // first scan: update
-  EXPECT_FALSE(localizer.processScan(pose(0.15, 0, 0), scan, mount));  // 0.15 m < 0.2 m
-  EXPECT_TRUE(localizer.processScan(pose(0.21, 0, 0), scan, mount));   // 0.21 m
-  EXPECT_FALSE(localizer.processScan(pose(0.21, 0.1, 0.4), scan, mount));  // 0.1 m, 0.4 rad
+  EXPECT_TRUE(localizer.processScan(pose(0, 0, 0), scan, mount));           // first scan: update
+  EXPECT_FALSE(localizer.processScan(pose(0.15, 0, 0), scan, mount));       // 0.15 m < 0.2 m
+  EXPECT_TRUE(localizer.processScan(pose(0.21, 0, 0), scan, mount));        // 0.21 m
+  EXPECT_FALSE(localizer.processScan(pose(0.21, 0.1, 0.4), scan, mount));   // 0.1 m, 0.4 rad
   EXPECT_TRUE(localizer.processScan(pose(0.21, 0.0, -0.51), scan, mount));  // 0.51 rad
   EXPECT_EQ(localizer.updates(), 3);
 }
@@ -516,7 +518,7 @@ TEST(GroundTruthMatcher, PairsByStampAndInterpolates)
   // after a simulation reset (time jumps back) the old samples are forgotten
   EXPECT_EQ(matcher.timeJumps(), 1);
   matcher.addGroundTruth({50 * ms, pose(1.0, 1.0, 0.0)});  // ground truth's timeline jumps too
-  EXPECT_EQ(matcher.timeJumps(), 2);  // clears the waiting odometry as well
+  EXPECT_EQ(matcher.timeJumps(), 2);                       // clears the waiting odometry as well
   matcher.addOdometry({50 * ms, pose(0.5, 0.0, 0.0)});
   matches = matcher.takeMatches();
   ASSERT_EQ(matches.size(), 1u);

@@ -82,7 +82,6 @@ def set_yaw(q, yaw):
     q.x, q.y, q.z, q.w = 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
-
 class PfLocalizationTest(unittest.TestCase):
     def setUp(self):
         self.robot = rospy.get_param("~robot")

@@ -2,8 +2,7 @@
 # navigation trial) and its tests. Included at the end of CMakeLists.txt, after catkin_package()
 # and include_directories().
 
-find_package(mbot_description REQUIRED)  # robot_model.h: footprint radius and limits
-find_package(roslib REQUIRED)            # ros::package::getPath("mbot_description")
+# mbot_description (robot_model.h) and roslib (ros::package::getPath) are found in CMakeLists.txt.
 
 # (catkin_python_setup() is in CMakeLists.txt: it must come before the dynamic_reconfigure options.)
 
@@ -40,7 +39,6 @@ if(CATKIN_ENABLE_TESTING)
   mbot_add_gtest(test_nav_core mbot_nav_core)
   mbot_add_gtest(test_nav_costmap_ros mbot_nav_ros)
 
-  find_package(rostest REQUIRED)
   # the parameter reader against a parameter server (move_base's key sets; no simulator)
   add_rostest_gtest(test_move_base_params test/move_base_params.test test/test_move_base_params.cpp)
   target_link_libraries(test_move_base_params mbot_nav_ros ${catkin_LIBRARIES})

@@ -53,11 +53,9 @@ void AStarPlanner::OpenList::reset(float f, uint32_t index)
 
 AStarPlanner::AStarPlanner(const AStarConfig& config) : config_(config)
 {
-  if (!(config.neutral_cost > 0.0))
-    throw std::invalid_argument("AStarConfig: 'neutral_cost' must be > 0");
+  if (!(config.neutral_cost > 0.0)) throw std::invalid_argument("AStarConfig: 'neutral_cost' must be > 0");
   if (!(config.cost_factor >= 0.0)) throw std::invalid_argument("AStarConfig: 'cost_factor' must be >= 0");
-  if (!(config.heuristic_weight >= 1.0))
-    throw std::invalid_argument("AStarConfig: 'heuristic_weight' must be >= 1");
+  if (!(config.heuristic_weight >= 1.0)) throw std::invalid_argument("AStarConfig: 'heuristic_weight' must be >= 1");
   if (!(config.smoothing_tolerance >= 0.0))
     throw std::invalid_argument("AStarConfig: 'smoothing_tolerance' must be >= 0");
   if (config.smoothing_passes < 1) throw std::invalid_argument("AStarConfig: 'smoothing_passes' must be >= 1");
@@ -125,8 +123,7 @@ PlanResult AStarPlanner::makePlan(const Costmap2D& costmap, const Pose2D& start,
     if (!costmap.worldToMap(p.x, p.y, cell[i][0], cell[i][1]))
     {
       result.error = std::string(what[i]) + " " + fmtPoint(p.x, p.y) + " is outside the map (x " +
-                     fmtPoint(costmap.originX(), costmap.originX() + costmap.sizeX() * costmap.resolution()) +
-                     ", y " +
+                     fmtPoint(costmap.originX(), costmap.originX() + costmap.sizeX() * costmap.resolution()) + ", y " +
                      fmtPoint(costmap.originY(), costmap.originY() + costmap.sizeY() * costmap.resolution()) + ")";
       return result;
     }
@@ -147,8 +144,8 @@ PlanResult AStarPlanner::makePlan(const Costmap2D& costmap, const Pose2D& start,
   const uint32_t g = static_cast<uint32_t>(costmap.index(cell[1][0], cell[1][1]));
   if (!search(costmap.data(), s, g))
   {
-    result.error = "goal " + fmtPoint(goal.x, goal.y) + " unreachable from start " +
-                   fmtPoint(start.x, start.y) + ": searched " + std::to_string(stats_.expanded) + " cells";
+    result.error = "goal " + fmtPoint(goal.x, goal.y) + " unreachable from start " + fmtPoint(start.x, start.y) +
+                   ": searched " + std::to_string(stats_.expanded) + " cells";
     return result;
   }
 
@@ -160,9 +157,7 @@ PlanResult AStarPlanner::makePlan(const Costmap2D& costmap, const Pose2D& start,
 
   // Poses at most one cell apart along the vertices; the ends are the exact start and goal.
   const double res = costmap.resolution();
-  auto centre = [&](uint32_t idx, double& x, double& y) {
-    costmap.mapToWorld(idx % size_x_, idx / size_x_, x, y);
-  };
+  auto centre = [&](uint32_t idx, double& x, double& y) { costmap.mapToWorld(idx % size_x_, idx / size_x_, x, y); };
   std::vector<Pose2D>& path = result.path;
   path.reserve(static_cast<size_t>(stats_.grid_path_length) + 2);
   double px = start.x, py = start.y;
@@ -314,8 +309,8 @@ namespace
  * @return false (early) at the first impassable cell; T through `T_out`
  */
 template <class Visit>
-bool traverse(const float* weight, const uint8_t* costs, unsigned size_x, uint32_t a, uint32_t b,
-              int64_t& T_out, Visit visit)
+bool traverse(const float* weight, const uint8_t* costs, unsigned size_x, uint32_t a, uint32_t b, int64_t& T_out,
+              Visit visit)
 {
   int x = static_cast<int>(a % size_x), y = static_cast<int>(a / size_x);
   const int bx = static_cast<int>(b % size_x), by = static_cast<int>(b / size_x);

@@ -28,20 +28,44 @@ std::string stripSlash(std::string frame)
 const std::vector<std::string> kIgnoredCostmapKeys = {"always_send_full_costmap"};
 const std::vector<std::string> kIgnoredStaticKeys = {"first_map_only", "subscribe_to_updates", "use_maximum"};
 const std::vector<std::string> kIgnoredObstacleKeys = {
-    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z",      "z_resolution",
-    "z_voxels",            "unknown_threshold",   "mark_threshold",     "publish_voxel_map"};
-const std::vector<std::string> kIgnoredSourceKeys = {"sensor_frame",        "observation_persistence",
+    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z", "z_resolution", "z_voxels",
+    "unknown_threshold",   "mark_threshold",      "publish_voxel_map"};
+const std::vector<std::string> kIgnoredSourceKeys = {"sensor_frame",         "observation_persistence",
                                                      "expected_update_rate", "min_obstacle_height",
-                                                     "max_obstacle_height", "inf_is_valid"};
+                                                     "max_obstacle_height",  "inf_is_valid"};
 // Flat layer keys: with `plugins`, costmap_2d reads them from the layers' namespaces instead.
-const std::vector<std::string> kFlatLayerKeys = {
-    "static_map",       "map_type",          "map_topic",          "lethal_cost_threshold", "unknown_cost_value",
-    "trinary_costmap",  "first_map_only",    "subscribe_to_updates", "use_maximum",       "scan_topic",
-    "observation_sources", "obstacle_range", "raytrace_range",     "footprint_clearing_enabled",
-    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z",         "z_resolution",
-    "z_voxels",         "unknown_threshold", "mark_threshold",     "publish_voxel_map",     "inflation_radius",
-    "cost_scaling_factor", "inflate_unknown", "robots_layer",      "robots_prediction_time",
-    "robots_prediction_step", "robots_prediction_cost", "robots_padding", "robots_scan_margin"};
+const std::vector<std::string> kFlatLayerKeys = {"static_map",
+                                                 "map_type",
+                                                 "map_topic",
+                                                 "lethal_cost_threshold",
+                                                 "unknown_cost_value",
+                                                 "trinary_costmap",
+                                                 "first_map_only",
+                                                 "subscribe_to_updates",
+                                                 "use_maximum",
+                                                 "scan_topic",
+                                                 "observation_sources",
+                                                 "obstacle_range",
+                                                 "raytrace_range",
+                                                 "footprint_clearing_enabled",
+                                                 "max_obstacle_height",
+                                                 "min_obstacle_height",
+                                                 "combination_method",
+                                                 "origin_z",
+                                                 "z_resolution",
+                                                 "z_voxels",
+                                                 "unknown_threshold",
+                                                 "mark_threshold",
+                                                 "publish_voxel_map",
+                                                 "inflation_radius",
+                                                 "cost_scaling_factor",
+                                                 "inflate_unknown",
+                                                 "robots_layer",
+                                                 "robots_prediction_time",
+                                                 "robots_prediction_step",
+                                                 "robots_prediction_cost",
+                                                 "robots_padding",
+                                                 "robots_scan_margin"};
 
 /// The static layer's keys of `p` (the costmap's namespace, or the layer's).
 void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
@@ -90,8 +114,8 @@ void readObstacleLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSet
       w.push_back("observation source " + source_nh.getNamespace() + ": data_type " + data_type +
                   " is not implemented (LaserScan only); ignored");
     else if (!s.scan_topic.empty())
-      w.push_back("observation source " + source_nh.getNamespace() +
-                  ": only one LaserScan source is implemented (" + s.scan_topic + " is used); ignored");
+      w.push_back("observation source " + source_nh.getNamespace() + ": only one LaserScan source is implemented (" +
+                  s.scan_topic + " is used); ignored");
     else if (!marking && !clearing)
       w.push_back("observation source " + source_nh.getNamespace() + ": neither marking nor clearing; ignored");
     else
@@ -144,8 +168,10 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
   if (list.getType() != XmlRpc::XmlRpcValue::TypeArray)
     throw std::runtime_error("parameter " + param + ": expected a list of {name: ..., type: ...}");
   static const std::vector<std::pair<std::string, LayerKind>> types = {
-      {"costmap_2d::StaticLayer", LayerKind::STATIC},       {"costmap_2d::ObstacleLayer", LayerKind::OBSTACLE},
-      {"costmap_2d::VoxelLayer", LayerKind::OBSTACLE},      {"costmap_2d::InflationLayer", LayerKind::INFLATION},
+      {"costmap_2d::StaticLayer", LayerKind::STATIC},
+      {"costmap_2d::ObstacleLayer", LayerKind::OBSTACLE},
+      {"costmap_2d::VoxelLayer", LayerKind::OBSTACLE},
+      {"costmap_2d::InflationLayer", LayerKind::INFLATION},
       {"mbot_navigation::RobotsLayer", LayerKind::ROBOTS}};
   s.static_map = s.robots_layer = s.inflation = false;
   s.scan_topic.clear();
@@ -301,7 +327,8 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
   if (c.rolling_window && !(c.width > 0.0 && c.height > 0.0))
     throw std::runtime_error("parameter " + ns + "width/height: expected numbers > 0 [m] for a rolling window");
   if (!c.rolling_window && !s.static_map)
-    throw std::runtime_error("parameter " + ns + "static_map: a costmap that is not a rolling window takes its size "
+    throw std::runtime_error("parameter " + ns +
+                             "static_map: a costmap that is not a rolling window takes its size "
                              "from the map, so static_map must be true");
   return s;
 }
@@ -333,7 +360,7 @@ void toOccupancyGrid(const Costmap2D& costmap, nav_msgs::OccupancyGrid& grid)
 
 CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settings, ros::NodeHandle& nh,
                        ros::NodeHandle& private_nh, tf2_ros::Buffer& tf)
-  : name_(name), settings_(settings), tf_(tf)
+    : name_(name), settings_(settings), tf_(tf)
 {
   layered_ = std::make_unique<LayeredCostmap>(settings.costmap);
   if (settings.static_map)
@@ -346,8 +373,8 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
     robots_layer_ = static_cast<RobotsLayer*>(&layered_->addLayer(std::make_unique<RobotsLayer>(settings.robots)));
   // Last: inflate everything below, teammates included.
   if (settings.inflation)
-    inflation_layer_ = static_cast<InflationLayer*>(
-        &layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer)));
+    inflation_layer_ =
+        static_cast<InflationLayer*>(&layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer)));
 
   // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
   if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
@@ -364,8 +391,8 @@ void CostmapRos::mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& map)
              name_.c_str(), map->header.frame_id.c_str(), settings_.global_frame.c_str());
   if (map->data.size() != static_cast<size_t>(map->info.width) * map->info.height || map->info.width == 0)
   {
-    ROS_ERROR("%s: ignoring a map of %ux%u cells with %zu values", name_.c_str(), map->info.width,
-              map->info.height, map->data.size());
+    ROS_ERROR("%s: ignoring a map of %ux%u cells with %zu values", name_.c_str(), map->info.width, map->info.height,
+              map->data.size());
     return;
   }
   static_layer_->setMap(map->info.width, map->info.height, map->info.resolution, map->info.origin.position.x,
@@ -381,10 +408,7 @@ void CostmapRos::scanCallback(const sensor_msgs::LaserScan::ConstPtr& scan)
   while (pending_scans_.size() > 50) pending_scans_.pop_front();  // tf is far behind: keep the newest
 }
 
-void CostmapRos::setTeammates(const std::vector<TeammateState>& teammates)
-{
-  teammates_ = teammates;
-}
+void CostmapRos::setTeammates(const std::vector<TeammateState>& teammates) { teammates_ = teammates; }
 
 std::vector<TeammateState> drawableTeammates(const std::vector<TeammateState>& teammates, const Pose2D& robot,
                                              double robot_radius, double resolution, double padding)
@@ -457,9 +481,8 @@ void CostmapRos::update(const Pose2D& robot, const ros::Time& now)
 {
   if (obstacle_layer_) applyScans(now);
   if (robots_layer_)
-    robots_layer_->setTeammates(
-        drawableTeammates(teammates_, robot, settings_.costmap.robot_radius, settings_.costmap.resolution,
-                          settings_.robots_padding));
+    robots_layer_->setTeammates(drawableTeammates(teammates_, robot, settings_.costmap.robot_radius,
+                                                  settings_.costmap.resolution, settings_.robots_padding));
   layered_->updateMap(robot);
   next_update_ = now + ros::Duration(1.0 / settings_.update_frequency);
 }
@@ -501,8 +524,7 @@ Costmap2D CostmapRos::staticCostmap() const
       static_cast<StaticLayer&>(costmap.addLayer(std::make_unique<StaticLayer>(settings_.static_layer)));
   if (settings_.inflation) costmap.addLayer(std::make_unique<InflationLayer>(settings_.inflation_layer));
   static_layer.setMap(last_map_->info.width, last_map_->info.height, last_map_->info.resolution,
-                      last_map_->info.origin.position.x, last_map_->info.origin.position.y,
-                      last_map_->data.data());
+                      last_map_->info.origin.position.x, last_map_->info.origin.position.y, last_map_->data.data());
   costmap.updateMap(Pose2D{});
   return costmap.costmap();
 }

@@ -19,9 +19,8 @@ constexpr double kReversal = -5.0;
 // ObstacleCritic
 
 ObstacleCritic::ObstacleCritic(double scale, double footprint_radius)
-  : TrajectoryCritic(scale), footprint_radius_(footprint_radius)
-{
-}
+    : TrajectoryCritic(scale), footprint_radius_(footprint_radius)
+{}
 
 bool ObstacleCritic::prepare(const CriticContext& context, std::string& /*error*/)
 {
@@ -98,13 +97,10 @@ double ObstacleCritic::score(const Trajectory& trajectory)
 // MapGridCritic
 
 MapGridCritic::MapGridCritic(double scale, Target target, double forward_shift, bool stop_on_failure)
-  : TrajectoryCritic(scale), target_(target), forward_shift_(forward_shift),
-    stop_on_failure_(stop_on_failure)
-{
-}
+    : TrajectoryCritic(scale), target_(target), forward_shift_(forward_shift), stop_on_failure_(stop_on_failure)
+{}
 
-bool MapGridCritic::computeMap(const Costmap2D& costmap, const std::vector<Pose2D>& targets,
-                               std::string& error)
+bool MapGridCritic::computeMap(const Costmap2D& costmap, const std::vector<Pose2D>& targets, std::string& error)
 {
   costmap_ = &costmap;
   size_x_ = costmap.sizeX();
@@ -253,10 +249,7 @@ bool PathAlignCritic::prepare(const CriticContext& context, std::string& error)
   return computeMap(context.costmap, context.plan, error);
 }
 
-double PathAlignCritic::score(const Trajectory& trajectory)
-{
-  return active_ ? MapGridCritic::score(trajectory) : 0.0;
-}
+double PathAlignCritic::score(const Trajectory& trajectory) { return active_ ? MapGridCritic::score(trajectory) : 0.0; }
 
 bool GoalAlignCritic::prepare(const CriticContext& context, std::string& error)
 {
@@ -274,9 +267,8 @@ bool GoalAlignCritic::prepare(const CriticContext& context, std::string& error)
 double OscillationCritic::score(const Trajectory& trajectory)
 {
   const Twist2D& v = trajectory.velocity;
-  if ((forward_pos_only_ && v.vx < 0.0) || (forward_neg_only_ && v.vx > 0.0) ||
-      (strafe_pos_only_ && v.vy < 0.0) || (strafe_neg_only_ && v.vy > 0.0) ||
-      (rot_pos_only_ && v.wz < 0.0) || (rot_neg_only_ && v.wz > 0.0))
+  if ((forward_pos_only_ && v.vx < 0.0) || (forward_neg_only_ && v.vx > 0.0) || (strafe_pos_only_ && v.vy < 0.0) ||
+      (strafe_neg_only_ && v.vy > 0.0) || (rot_pos_only_ && v.wz < 0.0) || (rot_neg_only_ && v.wz > 0.0))
     return kReversal;
   return 0.0;
 }
@@ -327,13 +319,12 @@ bool OscillationCritic::setFlags(const Trajectory& chosen, double min_vel_trans)
   return set;
 }
 
-void OscillationCritic::update(const Pose2D& robot_pose, const Trajectory& chosen,
-                               double min_vel_trans)
+void OscillationCritic::update(const Pose2D& robot_pose, const Trajectory& chosen, double min_vel_trans)
 {
   if (chosen.cost < 0.0) return;
   if (setFlags(chosen, min_vel_trans)) flag_pose_ = robot_pose;
-  const bool restricted = forward_pos_only_ || forward_neg_only_ || strafe_pos_only_ ||
-                          strafe_neg_only_ || rot_pos_only_ || rot_neg_only_;
+  const bool restricted =
+      forward_pos_only_ || forward_neg_only_ || strafe_pos_only_ || strafe_neg_only_ || rot_pos_only_ || rot_neg_only_;
   if (!restricted) return;
   const double dx = robot_pose.x - flag_pose_.x;
   const double dy = robot_pose.y - flag_pose_.y;
@@ -344,9 +335,6 @@ void OscillationCritic::update(const Pose2D& robot_pose, const Trajectory& chose
 // ---------------------------------------------------------------------------------------------
 // TwirlingCritic
 
-double TwirlingCritic::score(const Trajectory& trajectory)
-{
-  return std::fabs(trajectory.velocity.wz);
-}
+double TwirlingCritic::score(const Trajectory& trajectory) { return std::fabs(trajectory.velocity.wz); }
 
 }  // namespace mbot_navigation

@@ -101,16 +101,30 @@ DwaConfig shippedConfig(const std::string& path, const std::string& description_
   const YAML::Node dwa = yaml.load()["DWAPlannerROS"];
   if (!dwa) yaml.fail("DWAPlannerROS", "missing (the bench reads the keys from there)");
   const std::vector<std::pair<const char*, double*>> numbers = {
-      {"max_vel_trans", &c.max_vel_trans}, {"min_vel_trans", &c.min_vel_trans}, {"max_vel_x", &c.max_vel_x},
-      {"min_vel_x", &c.min_vel_x}, {"max_vel_y", &c.max_vel_y}, {"min_vel_y", &c.min_vel_y},
-      {"max_vel_theta", &c.max_vel_theta}, {"min_vel_theta", &c.min_vel_theta}, {"acc_lim_x", &c.acc_lim_x},
-      {"acc_lim_y", &c.acc_lim_y}, {"acc_lim_theta", &c.acc_lim_theta}, {"trans_stopped_vel", &c.trans_stopped_vel},
-      {"theta_stopped_vel", &c.theta_stopped_vel}, {"xy_goal_tolerance", &c.xy_goal_tolerance},
-      {"yaw_goal_tolerance", &c.yaw_goal_tolerance}, {"sim_time", &c.sim_time},
-      {"sim_granularity", &c.sim_granularity}, {"angular_sim_granularity", &c.angular_sim_granularity},
-      {"path_distance_bias", &c.path_distance_bias}, {"goal_distance_bias", &c.goal_distance_bias},
-      {"occdist_scale", &c.occdist_scale}, {"twirling_scale", &c.twirling_scale},
-      {"forward_point_distance", &c.forward_point_distance}, {"oscillation_reset_dist", &c.oscillation_reset_dist},
+      {"max_vel_trans", &c.max_vel_trans},
+      {"min_vel_trans", &c.min_vel_trans},
+      {"max_vel_x", &c.max_vel_x},
+      {"min_vel_x", &c.min_vel_x},
+      {"max_vel_y", &c.max_vel_y},
+      {"min_vel_y", &c.min_vel_y},
+      {"max_vel_theta", &c.max_vel_theta},
+      {"min_vel_theta", &c.min_vel_theta},
+      {"acc_lim_x", &c.acc_lim_x},
+      {"acc_lim_y", &c.acc_lim_y},
+      {"acc_lim_theta", &c.acc_lim_theta},
+      {"trans_stopped_vel", &c.trans_stopped_vel},
+      {"theta_stopped_vel", &c.theta_stopped_vel},
+      {"xy_goal_tolerance", &c.xy_goal_tolerance},
+      {"yaw_goal_tolerance", &c.yaw_goal_tolerance},
+      {"sim_time", &c.sim_time},
+      {"sim_granularity", &c.sim_granularity},
+      {"angular_sim_granularity", &c.angular_sim_granularity},
+      {"path_distance_bias", &c.path_distance_bias},
+      {"goal_distance_bias", &c.goal_distance_bias},
+      {"occdist_scale", &c.occdist_scale},
+      {"twirling_scale", &c.twirling_scale},
+      {"forward_point_distance", &c.forward_point_distance},
+      {"oscillation_reset_dist", &c.oscillation_reset_dist},
       {"oscillation_reset_angle", &c.oscillation_reset_angle}};
   const std::vector<std::pair<const char*, int*>> integers = {
       {"vx_samples", &c.vx_samples}, {"vy_samples", &c.vy_samples}, {"vth_samples", &c.vth_samples}};
@@ -162,10 +176,10 @@ int main(int argc, char** argv)
   // The robot at the centre of its rolling window.
   const Pose2D robot{0.0, 0.0, 0.1};
   Costmap2D map(80, 80, 0.05, -2.0, -2.0);
-  addBox(map, -1.5, 1.1, 0.2, 1.2);    // a wall on the left
-  addBox(map, 0.9, -0.9, 1.3, -0.5);   // a box on the right
-  addBox(map, 0.75, 0.75, 0.9, 0.9);   // a post ahead, left
-  addBox(map, 1.7, -0.1, 2.0, 0.1);    // something at the window's edge
+  addBox(map, -1.5, 1.1, 0.2, 1.2);       // a wall on the left
+  addBox(map, 0.9, -0.9, 1.3, -0.5);      // a box on the right
+  addBox(map, 0.75, 0.75, 0.9, 0.9);      // a post ahead, left
+  addBox(map, 1.7, -0.1, 2.0, 0.1);       // something at the window's edge
   InflationLayerConfig inflation_config;  // move_base's defaults: 0.55 m, scaling 10
   InflationLayer inflation(inflation_config);
   inflation.onFootprintChanged(0.15);  // mbot's footprint radius (URDF)
@@ -230,9 +244,9 @@ int main(int argc, char** argv)
   }
 
   std::fprintf(stderr, "dwa_bench: %s%s, %d cycles, %.1f trajectories per cycle, %d failed cycles\n",
-               omni ? "omni" : "diff drive", config_path.empty() ? "" : (", " + config_path).c_str(), cycles, static_cast<double>(samples) / cycles, failures);
-  std::printf("{\"p50\": %.4f, \"p99\": %.4f, \"wall_p50\": %.4f, \"wall_p99\": %.4f}\n",
-              percentile(times_ms, 0.50), percentile(times_ms, 0.99), percentile(wall_ms, 0.50),
-              percentile(wall_ms, 0.99));
+               omni ? "omni" : "diff drive", config_path.empty() ? "" : (", " + config_path).c_str(), cycles,
+               static_cast<double>(samples) / cycles, failures);
+  std::printf("{\"p50\": %.4f, \"p99\": %.4f, \"wall_p50\": %.4f, \"wall_p99\": %.4f}\n", percentile(times_ms, 0.50),
+              percentile(times_ms, 0.99), percentile(wall_ms, 0.50), percentile(wall_ms, 0.99));
   return failures == 0 ? 0 : 1;
 }

@@ -19,20 +19,20 @@ const DwaConfig& validated(const DwaConfig& config)
 }  // namespace
 
 DwaPlanner::DwaPlanner(const DwaConfig& config)
-  : config_(validated(config)),
-    generator_(config),
-    obstacle_critic_(config.occdist_scale, config.footprint_radius),
-    oscillation_critic_(config.oscillation_reset_dist, config.oscillation_reset_angle),
-    path_critic_(config.path_distance_bias),
-    goal_critic_(config.goal_distance_bias),
-    path_align_critic_(config.path_distance_bias, config.forward_point_distance),
-    goal_align_critic_(config.goal_distance_bias, config.forward_point_distance),
-    twirling_critic_(config.twirling_scale)
+    : config_(validated(config)),
+      generator_(config),
+      obstacle_critic_(config.occdist_scale, config.footprint_radius),
+      oscillation_critic_(config.oscillation_reset_dist, config.oscillation_reset_angle),
+      path_critic_(config.path_distance_bias),
+      goal_critic_(config.goal_distance_bias),
+      path_align_critic_(config.path_distance_bias, config.forward_point_distance),
+      goal_align_critic_(config.goal_distance_bias, config.forward_point_distance),
+      twirling_critic_(config.twirling_scale)
 {
   // Scoring order: the cheap critics that reject most come first, so that the early exit in
   // scoreTrajectory() saves the most work.
-  critics_ = {&oscillation_critic_, &obstacle_critic_, &path_critic_, &goal_critic_,
-              &path_align_critic_, &goal_align_critic_, &twirling_critic_};
+  critics_ = {&oscillation_critic_, &obstacle_critic_,   &path_critic_,    &goal_critic_,
+              &path_align_critic_,  &goal_align_critic_, &twirling_critic_};
 }
 
 void DwaPlanner::setPlan(const std::vector<Pose2D>& plan)
@@ -68,8 +68,7 @@ bool DwaPlanner::isGoalReached(const Pose2D& robot_pose, const Twist2D& robot_ve
   return std::fabs(yaw_error) <= config_.yaw_goal_tolerance && stopped;
 }
 
-LocalPlanResult DwaPlanner::computeVelocityCommands(const Pose2D& robot_pose,
-                                                    const Twist2D& robot_velocity,
+LocalPlanResult DwaPlanner::computeVelocityCommands(const Pose2D& robot_pose, const Twist2D& robot_velocity,
                                                     const Costmap2D& costmap, Twist2D& cmd)
 {
   cmd = Twist2D{};
@@ -151,8 +150,7 @@ double DwaPlanner::scoreTrajectory(const Trajectory& trajectory, double best, in
   return total;
 }
 
-LocalPlanResult DwaPlanner::followPlan(const Pose2D& robot_pose, const Twist2D& robot_velocity,
-                                       Twist2D& cmd)
+LocalPlanResult DwaPlanner::followPlan(const Pose2D& robot_pose, const Twist2D& robot_velocity, Twist2D& cmd)
 {
   LocalPlanResult result;
   result.state = LocalPlannerState::FOLLOWING;
@@ -206,8 +204,7 @@ LocalPlanResult DwaPlanner::followPlan(const Pose2D& robot_pose, const Twist2D& 
   return result;
 }
 
-LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2D& robot_velocity,
-                                          Twist2D& cmd)
+LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2D& robot_velocity, Twist2D& cmd)
 {
   LocalPlanResult result;
   const double dt = config_.simPeriod();
@@ -238,11 +235,9 @@ LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2
     rotating_to_goal_ = true;
     // Turn as fast as allowed, but no faster than lets us stop at the goal yaw
     // (v^2 = 2 a d), and not so slowly that the base stalls (min_vel_theta).
-    double speed = std::min(config_.max_vel_theta,
-                            std::sqrt(2.0 * config_.acc_lim_theta * std::fabs(yaw_error)));
+    double speed = std::min(config_.max_vel_theta, std::sqrt(2.0 * config_.acc_lim_theta * std::fabs(yaw_error)));
     speed = std::max(speed, config_.min_vel_theta);
-    command.wz = stepTowards(robot_velocity.wz, std::copysign(speed, yaw_error),
-                             config_.acc_lim_theta * dt);
+    command.wz = stepTowards(robot_velocity.wz, std::copysign(speed, yaw_error), config_.acc_lim_theta * dt);
   }
 
   // The command must leave the robot clear of obstacles until it has braked to a stop.

@@ -134,8 +134,8 @@ std::string StaticGoalChecker::check(const Pose2D* start, const Pose2D& goal) co
   const int32_t from = regionNear(start->x, start->y, escape_radius_);
   if (from < 0) return "";  // the robot itself is stuck: let the planner and the recoveries try
   if (label_[costmap_.index(mx, my)] != from)
-    return "no path from start to goal: " + formatPoint(goal.x, goal.y) +
-           " is not connected to the robot's position " + formatPoint(start->x, start->y) + " on the map";
+    return "no path from start to goal: " + formatPoint(goal.x, goal.y) + " is not connected to the robot's position " +
+           formatPoint(start->x, start->y) + " on the map";
   return "";
 }
 

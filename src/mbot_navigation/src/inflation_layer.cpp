@@ -8,10 +8,7 @@
 
 namespace mbot_navigation
 {
-InflationLayer::InflationLayer(const InflationLayerConfig& config)
-{
-  setConfig(config);
-}
+InflationLayer::InflationLayer(const InflationLayerConfig& config) { setConfig(config); }
 
 void InflationLayer::setConfig(const InflationLayerConfig& config)
 {
@@ -98,8 +95,7 @@ void InflationLayer::updateCosts(Costmap2D& master, const CellWindow& w)
     const uint8_t* row = costs + master.index(sx0, sy0 + y);
     int* out = &col_dist_[static_cast<size_t>(y) * W];
     const int* prev = y > 0 ? out - W : nullptr;
-    for (int x = 0; x < W; ++x)
-      out[x] = row[x] == cost::LETHAL ? 0 : (prev ? std::min(prev[x] + 1, cap) : cap);
+    for (int x = 0; x < W; ++x) out[x] = row[x] == cost::LETHAL ? 0 : (prev ? std::min(prev[x] + 1, cap) : cap);
   }
   for (int y = H - 2; y >= 0; --y)
   {

@@ -21,8 +21,8 @@ LayeredCostmap::LayeredCostmap(const LayeredCostmapConfig& config) : config_(con
   if (!(config.robot_radius >= 0.0))
     throw std::invalid_argument("LayeredCostmapConfig: 'robot_radius' must be >= 0 [m]");
   costmap_ = Costmap2D(cellsFor(config.width, config.resolution, "width"),
-                       cellsFor(config.height, config.resolution, "height"), config.resolution,
-                       config.origin_x, config.origin_y, defaultValue());
+                       cellsFor(config.height, config.resolution, "height"), config.resolution, config.origin_x,
+                       config.origin_y, defaultValue());
 }
 
 Layer& LayeredCostmap::addLayer(std::unique_ptr<Layer> layer)
@@ -36,8 +36,7 @@ Layer& LayeredCostmap::addLayer(std::unique_ptr<Layer> layer)
   return *layers_.back();
 }
 
-void LayeredCostmap::resizeMap(unsigned size_x, unsigned size_y, double resolution, double origin_x,
-                               double origin_y)
+void LayeredCostmap::resizeMap(unsigned size_x, unsigned size_y, double resolution, double origin_x, double origin_y)
 {
   costmap_ = Costmap2D(size_x, size_y, resolution, origin_x, origin_y, defaultValue());
   config_.resolution = resolution;

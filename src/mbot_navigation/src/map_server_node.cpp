@@ -59,11 +59,12 @@ public:
     params.checkNoUnknown();
     const std::string name = argument.empty() ? param_map : argument;
     if (name.empty())
-      throw std::runtime_error("no map given: rosrun mbot_navigation map_server MAP.yaml, or the "
-                               "parameter ~map (a path, or a name in the workspace maps/ folder)");
+      throw std::runtime_error(
+          "no map given: rosrun mbot_navigation map_server MAP.yaml, or the "
+          "parameter ~map (a path, or a name in the workspace maps/ folder)");
     // a bare name: maps/NAME.yaml next to this package's workspace, then mbot_common's workspace
-    const std::string path = mbot_common::resolveMapPath(
-        name, mbot_common::findMapsDirectory(ros::package::getPath("mbot_navigation")));
+    const std::string path =
+        mbot_common::resolveMapPath(name, mbot_common::findMapsDirectory(ros::package::getPath("mbot_navigation")));
 
     grid_ = toOccupancyGrid(mbot_common::loadMap(path), frame_id);  // throws MapError naming the file
     map_pub_ = nh.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
@@ -71,9 +72,9 @@ public:
     service_ = nh.advertiseService("static_map", &MapServerNode::onGetMap, this);
     map_pub_.publish(grid_);
     metadata_pub_.publish(grid_.info);
-    ROS_INFO("map_server: %s: %u x %u cells at %.3f m/cell, origin (%.3f, %.3f), frame %s",
-             path.c_str(), grid_.info.width, grid_.info.height, grid_.info.resolution,
-             grid_.info.origin.position.x, grid_.info.origin.position.y, frame_id.c_str());
+    ROS_INFO("map_server: %s: %u x %u cells at %.3f m/cell, origin (%.3f, %.3f), frame %s", path.c_str(),
+             grid_.info.width, grid_.info.height, grid_.info.resolution, grid_.info.origin.position.x,
+             grid_.info.origin.position.y, frame_id.c_str());
   }
 
 private:

@@ -15,19 +15,20 @@ namespace
 {
 // Standard keys this node does not implement (docs/move_base_keys.md), by namespace.
 const std::vector<std::string> kIgnoredMoveBaseKeys = {
-    "recovery_behaviors",       "conservative_reset_dist", "shutdown_costmaps",
-    "max_planning_retries",     "make_plan_clear_costmap", "make_plan_add_unreachable_goal",
-    "restore_defaults",         "conservative_reset",      "aggressive_reset",
-    "TrajectoryPlannerROS",     "CarrotPlanner"};
-const std::vector<std::string> kIgnoredGlobalPlannerKeys = {
-    "default_tolerance", "visualize_potential", "use_dijkstra",       "use_quadratic",
-    "use_grid_path",     "old_navfn_behavior",  "lethal_cost",        "publish_potential",
-    "orientation_mode",  "orientation_window_size", "outline_map",    "planner_window_x",
-    "planner_window_y",  "planner_costmap_publish_frequency", "restore_defaults"};
+    "recovery_behaviors",      "conservative_reset_dist",        "shutdown_costmaps", "max_planning_retries",
+    "make_plan_clear_costmap", "make_plan_add_unreachable_goal", "restore_defaults",  "conservative_reset",
+    "aggressive_reset",        "TrajectoryPlannerROS",           "CarrotPlanner"};
+const std::vector<std::string> kIgnoredGlobalPlannerKeys = {"default_tolerance", "visualize_potential",
+                                                            "use_dijkstra",      "use_quadratic",
+                                                            "use_grid_path",     "old_navfn_behavior",
+                                                            "lethal_cost",       "publish_potential",
+                                                            "orientation_mode",  "orientation_window_size",
+                                                            "outline_map",       "planner_window_x",
+                                                            "planner_window_y",  "planner_costmap_publish_frequency",
+                                                            "restore_defaults"};
 const std::vector<std::string> kIgnoredDwaKeys = {
-    "acc_lim_trans",  "acc_limit_trans", "stop_time_buffer", "scaling_speed",     "max_scaling_factor",
-    "use_dwa",        "publish_traj_pc", "publish_cost_grid_pc", "global_frame_id", "meter_scoring",
-    "restore_defaults"};
+    "acc_lim_trans",   "acc_limit_trans",      "stop_time_buffer", "scaling_speed", "max_scaling_factor", "use_dwa",
+    "publish_traj_pc", "publish_cost_grid_pc", "global_frame_id",  "meter_scoring", "restore_defaults"};
 
 /// DWA keys may be given flat (~max_vel_x) or under ~DWAPlannerROS/ (dwa_local_planner's place).
 /// Where both are set they must agree (dynamic_reconfigure writes ~DWAPlannerROS/ at start-up,
@@ -36,9 +37,8 @@ class DwaParams
 {
 public:
   DwaParams(const ros::NodeHandle& private_nh, StrictParams& flat, StrictParams& scoped)
-    : nh_(private_nh), flat_(flat), scoped_(scoped)
-  {
-  }
+      : nh_(private_nh), flat_(flat), scoped_(scoped)
+  {}
   double getDouble(const std::string& key, double d, const std::string& old_name = "")
   {
     if (!old_name.empty()) d = get(old_name, d, &StrictParams::getDouble);
@@ -180,7 +180,8 @@ void ignoreStandardKeys(StrictParams& p, const ros::NodeHandle& nh, const std::v
   {
     if (!nh.hasParam(key)) continue;
     p.markKnown(key);
-    warnings.push_back("parameter " + nh.resolveName(key) + ": " + what + " that this node does not implement; ignored");
+    warnings.push_back("parameter " + nh.resolveName(key) + ": " + what +
+                       " that this node does not implement; ignored");
   }
 }
 
@@ -210,7 +211,8 @@ double footprintRadius(const XmlRpc::XmlRpcValue& footprint, const std::string& 
   {
     // costmap_2d also takes "[[x, y], [x, y], ...]" as a string.
     std::string text = static_cast<std::string>(const_cast<XmlRpc::XmlRpcValue&>(footprint));
-    std::replace_if(text.begin(), text.end(), [](char ch) { return ch == '[' || ch == ']' || ch == ','; }, ' ');
+    std::replace_if(
+        text.begin(), text.end(), [](char ch) { return ch == '[' || ch == ']' || ch == ','; }, ' ');
     std::istringstream in(text);
     double x, y;
     while (in >> x)

@@ -37,8 +37,12 @@ geometry_msgs::PoseStamped toPoseStamped(const Pose2D& p, const std::string& fra
 TeammateTracker::TeammateTracker(tf2_ros::Buffer& tf, const std::string& self, const std::string& global_frame,
                                  Source source, const std::vector<std::string>& names, double timeout,
                                  std::function<double(const std::string&)> radius_of)
-  : tf_(tf), self_(self), global_frame_(global_frame), source_(source), timeout_(timeout),
-    radius_of_(std::move(radius_of))
+    : tf_(tf),
+      self_(self),
+      global_frame_(global_frame),
+      source_(source),
+      timeout_(timeout),
+      radius_of_(std::move(radius_of))
 {
   for (const std::string& name : names)
     if (name != self_) track(name);
@@ -51,9 +55,8 @@ void TeammateTracker::track(const std::string& name)
   mate.radius = radius_of_(name);
   ros::NodeHandle root;
   const std::string topic = "/" + name + (source_ == Source::GROUND_TRUTH ? "/base_pose_ground_truth" : "/odom");
-  mate.sub = root.subscribe<nav_msgs::Odometry>(topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) {
-    mates_[name].last = msg;
-  });
+  mate.sub = root.subscribe<nav_msgs::Odometry>(
+      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; });
   ROS_INFO("teammate %s: from %s (radius %.2f m)", name.c_str(), topic.c_str(), mate.radius);
 }
 
@@ -114,8 +117,7 @@ std::vector<TeammateState> TeammateTracker::states(const ros::Time& now) const
 // =============================================================================================
 // NavNode: set-up
 
-NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-  : nh_(nh), private_nh_(private_nh)
+NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), private_nh_(private_nh)
 {
   description_dir_ = ros::package::getPath("mbot_description");
   if (description_dir_.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
@@ -180,9 +182,8 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (params.robots.empty())
   {
     teammates_->discover();
-    discovery_timer_ = nh_.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) {
-      teammates_->discover();
-    });
+    discovery_timer_ =
+        nh_.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) { teammates_->discover(); });
   }
 
   // --- the move_base interface
@@ -201,10 +202,11 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   cycle_timer_ = nh_.createTimer(ros::Duration(control_period_), &NavNode::cycle, this);
   startReconfigureServers();
 
-  ROS_INFO("%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
-           "waiting for the map and the robot's pose",
-           private_nh_.getNamespace().c_str(), robot_.c_str(), own_model_.c_str(), own_radius_,
-           global_planner_name.c_str(), controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str());
+  ROS_INFO(
+      "%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
+      "waiting for the map and the robot's pose",
+      private_nh_.getNamespace().c_str(), robot_.c_str(), own_model_.c_str(), own_radius_, global_planner_name.c_str(),
+      controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str());
 }
 
 double NavNode::teammateRadius(const std::string& name)
@@ -226,8 +228,8 @@ double NavNode::teammateRadius(const std::string& name)
   }
   catch (const std::exception& e)
   {
-    ROS_WARN("teammate %s: cannot load model '%s' (%s); assuming radius %.2f m", name.c_str(), model.c_str(),
-             e.what(), radius);
+    ROS_WARN("teammate %s: cannot load model '%s' (%s); assuming radius %.2f m", name.c_str(), model.c_str(), e.what(),
+             radius);
   }
   model_radius_[model] = radius;
   return radius;
@@ -417,7 +419,8 @@ void NavNode::startReconfigureServers()
     if (!costmap->settings().inflation) continue;
     const InflationLayerConfig& i = costmap->settings().inflation_layer;
     inflation_servers_.push_back(std::make_unique<dynamic_reconfigure::Server<InflationConfig>>(
-        reconfigure_mutex_, ros::NodeHandle(private_nh_, costmap->name() + "/" + costmap->settings().inflation_layer_name)));
+        reconfigure_mutex_,
+        ros::NodeHandle(private_nh_, costmap->name() + "/" + costmap->settings().inflation_layer_name)));
     InflationConfig ic;
     ic.inflation_radius = i.inflation_radius;
     ic.cost_scaling_factor = i.cost_scaling_factor;
@@ -494,10 +497,7 @@ void NavNode::onInflationReconfigure(CostmapRos& costmap, InflationConfig& c)
   }
 }
 
-void NavNode::publishZero()
-{
-  cmd_vel_pub_.publish(geometry_msgs::Twist());
-}
+void NavNode::publishZero() { cmd_vel_pub_.publish(geometry_msgs::Twist()); }
 
 void NavNode::publishPath(const ros::Publisher& pub, const std::vector<Pose2D>& path, const ros::Time& stamp) const
 {

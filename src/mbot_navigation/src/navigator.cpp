@@ -18,8 +18,7 @@ std::string join(const std::vector<std::string>& items)
 double pathLength(const std::vector<Pose2D>& path)
 {
   double length = 0.0;
-  for (size_t i = 1; i < path.size(); ++i)
-    length += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
+  for (size_t i = 1; i < path.size(); ++i) length += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
   return length;
 }
 }  // namespace
@@ -38,12 +37,14 @@ const char* toString(NavState state)
 
 Navigator::Navigator(const NavigatorConfig& config, const DwaConfig& dwa, std::unique_ptr<GlobalPlanner> planner,
                      std::vector<std::unique_ptr<RecoveryBehavior>> recoveries)
-  : config_(config), planner_(std::move(planner)), dwa_(std::make_unique<DwaPlanner>(dwa)),
-    recoveries_(std::move(recoveries))
+    : config_(config),
+      planner_(std::move(planner)),
+      dwa_(std::make_unique<DwaPlanner>(dwa)),
+      recoveries_(std::move(recoveries))
 {
   if (!planner_) throw std::invalid_argument("Navigator: no global planner");
-  if (!(config.planner_patience >= 0.0) || !(config.controller_patience >= 0.0) ||
-      !(config.planner_frequency >= 0.0) || !(config.oscillation_timeout >= 0.0))
+  if (!(config.planner_patience >= 0.0) || !(config.controller_patience >= 0.0) || !(config.planner_frequency >= 0.0) ||
+      !(config.oscillation_timeout >= 0.0))
     throw std::invalid_argument(
         "Navigator: planner_patience, controller_patience, planner_frequency and oscillation_timeout must be >= 0");
 }
@@ -217,8 +218,9 @@ NavCycleResult Navigator::cycle(double now, const Pose2D& pose, const Twist2D& v
       if (now - plan_needed_since_ > config_.planner_patience)
       {
         char buf[96];
-        std::snprintf(buf, sizeof(buf), "the global planner (%s) found no valid plan for %.1f s: ",
-                      planner_->name().c_str(), config_.planner_patience);
+        std::snprintf(buf, sizeof(buf),
+                      "the global planner (%s) found no valid plan for %.1f s: ", planner_->name().c_str(),
+                      config_.planner_patience);
         return recover(buf + error, input);
       }
       return result;  // stand still, try again next cycle
@@ -289,8 +291,8 @@ NavCycleResult Navigator::control(double now, const Pose2D& pose, const Twist2D&
   if (now - last_valid_control_ > config_.controller_patience)
   {
     char buf[96];
-    std::snprintf(buf, sizeof(buf), "the local planner (DWA) found no valid velocity command for %.1f s: ",
-                  config_.controller_patience);
+    std::snprintf(buf, sizeof(buf),
+                  "the local planner (DWA) found no valid velocity command for %.1f s: ", config_.controller_patience);
     return recover(buf + local.error, input);
   }
   // As move_base: stand still and plan again (the plan may be what the local planner cannot follow).

@@ -11,10 +11,7 @@ void ScanObservation::addEndpoint(double x, double y)
   beams.push_back({std::atan2(y - origin_y, x - origin_x), std::hypot(x - origin_x, y - origin_y)});
 }
 
-void ScanObservation::addNoReturn(double angle)
-{
-  beams.push_back({angle, std::numeric_limits<double>::infinity()});
-}
+void ScanObservation::addNoReturn(double angle) { beams.push_back({angle, std::numeric_limits<double>::infinity()}); }
 
 ObstacleLayer::ObstacleLayer(const ObstacleLayerConfig& config) : config_(config)
 {
@@ -24,8 +21,8 @@ ObstacleLayer::ObstacleLayer(const ObstacleLayerConfig& config) : config_(config
 
 void ObstacleLayer::matchSize(const Costmap2D& master)
 {
-  grid_ = Costmap2D(master.sizeX(), master.sizeY(), master.resolution(), master.originX(),
-                    master.originY(), unknownValue());
+  grid_ = Costmap2D(master.sizeX(), master.sizeY(), master.resolution(), master.originX(), master.originY(),
+                    unknownValue());
 }
 
 void ObstacleLayer::updateOrigin(double new_origin_x, double new_origin_y)
@@ -42,8 +39,7 @@ void ObstacleLayer::reset()
 namespace
 {
 /// Clip the segment p0 -> p1 [m] to the box [lo, hi] (Liang-Barsky); t1 is the kept end fraction.
-bool clipEnd(double x0, double y0, double dx, double dy, double lo_x, double lo_y, double hi_x,
-             double hi_y, double& t1)
+bool clipEnd(double x0, double y0, double dx, double dy, double lo_x, double lo_y, double hi_x, double hi_y, double& t1)
 {
   t1 = 1.0;
   const double p[4] = {-dx, dx, -dy, dy};
@@ -126,8 +122,7 @@ void ObstacleLayer::updateBounds(const Pose2D& robot, Bounds& bounds)
     for (const ScanBeam& beam : scan.beams)
     {
       const double r = beam.range;
-      if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max || r > config_.obstacle_range)
-        continue;
+      if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max || r > config_.obstacle_range) continue;
       const double px = scan.origin_x + r * std::cos(beam.angle);
       const double py = scan.origin_y + r * std::sin(beam.angle);
       unsigned mx, my;

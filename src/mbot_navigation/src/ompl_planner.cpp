@@ -46,8 +46,7 @@ std::string formatXY(const Pose2D& p)
 /// True when the robot's centre may be in cell (mx, my): inside the map and not (near) an obstacle.
 bool cellFree(const Costmap2D& map, int mx, int my)
 {
-  if (mx < 0 || my < 0 || mx >= static_cast<int>(map.sizeX()) || my >= static_cast<int>(map.sizeY()))
-    return false;
+  if (mx < 0 || my < 0 || mx >= static_cast<int>(map.sizeX()) || my >= static_cast<int>(map.sizeY())) return false;
   return map.cost(mx, my) < cost::INSCRIBED;
 }
 
@@ -120,10 +119,7 @@ double firstBlocked(const Costmap2D& map, double ax, double ay, double bx, doubl
 class GridMotionValidator : public ob::MotionValidator
 {
 public:
-  GridMotionValidator(const ob::SpaceInformationPtr& si, const Costmap2D& map)
-    : ob::MotionValidator(si), map_(map)
-  {
-  }
+  GridMotionValidator(const ob::SpaceInformationPtr& si, const Costmap2D& map) : ob::MotionValidator(si), map_(map) {}
 
   bool checkMotion(const ob::State* s1, const ob::State* s2) const override
   {
@@ -136,8 +132,7 @@ public:
     return false;
   }
 
-  bool checkMotion(const ob::State* s1, const ob::State* s2,
-                   std::pair<ob::State*, double>& last_valid) const override
+  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override
   {
     const double t = blockedAt(s1, s2);
     if (t < 0.0)
@@ -147,8 +142,7 @@ public:
     }
     // The last valid state lies just before the first blocked cell.
     last_valid.second = std::max(0.0, t - 1e-6);
-    if (last_valid.first != nullptr)
-      si_->getStateSpace()->interpolate(s1, s2, last_valid.second, last_valid.first);
+    if (last_valid.first != nullptr) si_->getStateSpace()->interpolate(s1, s2, last_valid.second, last_valid.first);
     ++invalid_;
     return false;
   }
@@ -174,7 +168,7 @@ class CostmapObjective : public ob::StateCostIntegralObjective
 {
 public:
   CostmapObjective(const ob::SpaceInformationPtr& si, const Costmap2D& map, double weight)
-    : ob::StateCostIntegralObjective(si, true), map_(map), weight_(weight)
+      : ob::StateCostIntegralObjective(si, true), map_(map), weight_(weight)
   {
     description_ = "costmap cost integral";
   }
@@ -236,7 +230,7 @@ private:
 bool relaxPath(og::PathGeometric& path, const ob::OptimizationObjective& objective, double spacing, double step,
                double min_step, const ob::PlannerTerminationCondition& ptc)
 {
-  constexpr int kMaxSweeps = 100;  // per step size
+  constexpr int kMaxSweeps = 100;    // per step size
   constexpr double kMinGain = 1e-9;  // a move must gain more than rounding noise
   const ob::SpaceInformationPtr& si = path.getSpaceInformation();
   path.interpolate(static_cast<unsigned>(std::ceil(path.length() / spacing)) + 1);
@@ -345,8 +339,7 @@ OmplPlanner::OmplPlanner(const OmplConfig& config) : config_(config)
     throw std::invalid_argument("OMPL planner '" + config_.planner +
                                 "' is unknown: expected rrtstar, prmstar or rrtconnect");
   if (!(config_.time_limit > 0.0))
-    throw std::invalid_argument("OMPL time_limit = " + std::to_string(config_.time_limit) +
-                                ": expected > 0 [s]");
+    throw std::invalid_argument("OMPL time_limit = " + std::to_string(config_.time_limit) + ": expected > 0 [s]");
   if (!(config_.simplify_time_limit >= 0.0))
     throw std::invalid_argument("OMPL simplify_time_limit = " + std::to_string(config_.simplify_time_limit) +
                                 ": expected >= 0 [s]");
@@ -406,9 +399,8 @@ PlanResult OmplPlanner::makePlan(const Costmap2D& costmap, const Pose2D& start, 
   if (status != ob::PlannerStatus::EXACT_SOLUTION)
   {
     char buf[160];
-    std::snprintf(buf, sizeof(buf), "%s found no path from %s to %s within %.2f s (%s)",
-                  config_.planner.c_str(), formatXY(start).c_str(), formatXY(goal).c_str(),
-                  config_.time_limit, status.asString().c_str());
+    std::snprintf(buf, sizeof(buf), "%s found no path from %s to %s within %.2f s (%s)", config_.planner.c_str(),
+                  formatXY(start).c_str(), formatXY(goal).c_str(), config_.time_limit, status.asString().c_str());
     result.error = buf;
     return result;
   }

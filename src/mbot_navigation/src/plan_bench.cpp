@@ -244,13 +244,20 @@ int main(int argc, char** argv)
         usage(a + " expects a number, got '" + v + "'");
       }
     };
-    if (a == "--map") map_path = value();
-    else if (a == "--pairs") pairs_path = value();
-    else if (a == "--config") value();  // read above
-    else if (a == "--planner") planner_name = value();
-    else if (a == "--json") json = true;
-    else if (a == "--verify-inflation") verify = true;
-    else if (a == "--per-pair") per_pair = true;
+    if (a == "--map")
+      map_path = value();
+    else if (a == "--pairs")
+      pairs_path = value();
+    else if (a == "--config")
+      value();  // read above
+    else if (a == "--planner")
+      planner_name = value();
+    else if (a == "--json")
+      json = true;
+    else if (a == "--verify-inflation")
+      verify = true;
+    else if (a == "--per-pair")
+      per_pair = true;
     else if (a == "--repeat")
     {
       repeat = static_cast<int>(number());
@@ -264,13 +271,20 @@ int main(int argc, char** argv)
       for (size_t k; s >> k;) only.push_back(k);
       if (only.empty()) usage("--only expects pair indices, e.g. 3,17");
     }
-    else if (a == "--cost-factor") params.astar.cost_factor = number();
-    else if (a == "--neutral-cost") params.astar.neutral_cost = number();
-    else if (a == "--heuristic-weight") params.astar.heuristic_weight = number();
-    else if (a == "--smoothing-tolerance") params.astar.smoothing_tolerance = number();
-    else if (a == "--no-smooth") params.astar.smooth_path = false;
-    else if (a == "--smoothing-passes") params.astar.smoothing_passes = static_cast<int>(number());
-    else usage("unknown argument '" + a + "'");
+    else if (a == "--cost-factor")
+      params.astar.cost_factor = number();
+    else if (a == "--neutral-cost")
+      params.astar.neutral_cost = number();
+    else if (a == "--heuristic-weight")
+      params.astar.heuristic_weight = number();
+    else if (a == "--smoothing-tolerance")
+      params.astar.smoothing_tolerance = number();
+    else if (a == "--no-smooth")
+      params.astar.smooth_path = false;
+    else if (a == "--smoothing-passes")
+      params.astar.smoothing_passes = static_cast<int>(number());
+    else
+      usage("unknown argument '" + a + "'");
   }
   if (map_path.empty() || pairs_path.empty()) usage("--map and --pairs are required");
 
@@ -295,10 +309,11 @@ int main(int argc, char** argv)
     if (astar)
     {
       const AStarConfig& c = astar->config();
-      std::printf("A*: neutral_cost %g, cost_factor %g, heuristic_weight %g, smooth_path %s, smoothing_tolerance %g, "
-                  "smoothing_passes %d\n",
-                  c.neutral_cost, c.cost_factor, c.heuristic_weight, c.smooth_path ? "true" : "false",
-                  c.smoothing_tolerance, c.smoothing_passes);
+      std::printf(
+          "A*: neutral_cost %g, cost_factor %g, heuristic_weight %g, smooth_path %s, smoothing_tolerance %g, "
+          "smoothing_passes %d\n",
+          c.neutral_cost, c.cost_factor, c.heuristic_weight, c.smooth_path ? "true" : "false", c.smoothing_tolerance,
+          c.smoothing_passes);
     }
 
     auto pose = [&](int x, int y) {
@@ -376,9 +391,10 @@ int main(int argc, char** argv)
       return v.empty() ? 0.0 : sum / v.size();
     };
     const double mean_len = mean(lengths), mean_cost = mean(costs);
-    std::printf("planner %s on %s: %zu pairs, mean path %.1f cells, mean path cost %.1f, failures %d, "
-                "invalid paths %d\n",
-                planner->name().c_str(), map_path.c_str(), pairs.size(), mean_len, mean_cost, failures, invalid);
+    std::printf(
+        "planner %s on %s: %zu pairs, mean path %.1f cells, mean path cost %.1f, failures %d, "
+        "invalid paths %d\n",
+        planner->name().c_str(), map_path.c_str(), pairs.size(), mean_len, mean_cost, failures, invalid);
     std::printf("  one plan per pair:  p50 %.3f ms, p95 %.3f ms, max %.3f ms; thread CPU p50 %.3f ms, p95 %.3f ms\n",
                 percentile(ms, 0.5), percentile(ms, 0.95), percentile(ms, 1.0), percentile(cpu_ms, 0.5),
                 percentile(cpu_ms, 0.95));
@@ -393,12 +409,13 @@ int main(int argc, char** argv)
       // Without the fastest-of pass its keys repeat the single plans' figures.
       const std::vector<double>& b = best_ms.empty() ? ms : best_ms;
       const std::vector<double>& bc = best_cpu_ms.empty() ? cpu_ms : best_cpu_ms;
-      std::printf("{\"single_p50\": %.4f, \"single_p95\": %.4f, \"single_cpu_p50\": %.4f, \"single_cpu_p95\": %.4f, "
-                  "\"p50\": %.4f, \"p95\": %.4f, \"cpu_p50\": %.4f, \"cpu_p95\": %.4f, \"repeat\": %d, "
-                  "\"mean_path_cells\": %.2f, \"mean_path_cost\": %.2f, \"failures\": %d, \"invalid_paths\": %d}\n",
-                  percentile(ms, 0.5), percentile(ms, 0.95), percentile(cpu_ms, 0.5), percentile(cpu_ms, 0.95),
-                  percentile(b, 0.5), percentile(b, 0.95), percentile(bc, 0.5), percentile(bc, 0.95), repeat, mean_len,
-                  mean_cost, failures, invalid);
+      std::printf(
+          "{\"single_p50\": %.4f, \"single_p95\": %.4f, \"single_cpu_p50\": %.4f, \"single_cpu_p95\": %.4f, "
+          "\"p50\": %.4f, \"p95\": %.4f, \"cpu_p50\": %.4f, \"cpu_p95\": %.4f, \"repeat\": %d, "
+          "\"mean_path_cells\": %.2f, \"mean_path_cost\": %.2f, \"failures\": %d, \"invalid_paths\": %d}\n",
+          percentile(ms, 0.5), percentile(ms, 0.95), percentile(cpu_ms, 0.5), percentile(cpu_ms, 0.95),
+          percentile(b, 0.5), percentile(b, 0.95), percentile(bc, 0.5), percentile(bc, 0.95), repeat, mean_len,
+          mean_cost, failures, invalid);
     }
     return (failures == 0 && invalid == 0) ? 0 : 1;
   }

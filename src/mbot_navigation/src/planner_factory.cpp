@@ -4,10 +4,7 @@
 
 namespace mbot_navigation
 {
-std::vector<std::string> globalPlannerNames()
-{
-  return {"astar", "ompl"};
-}
+std::vector<std::string> globalPlannerNames() { return {"astar", "ompl"}; }
 
 std::unique_ptr<GlobalPlanner> makeGlobalPlanner(const std::string& name, const GlobalPlannerParams& params)
 {

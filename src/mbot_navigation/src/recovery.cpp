@@ -121,9 +121,8 @@ RecoveryStatus BackUpRecovery::step(const RecoveryInput& input, Twist2D& cmd)
     return RecoveryStatus::FAILED;
   }
   // Re-check the way behind on the updated costmap (something may have moved in).
-  if (input.local_costmap &&
-      freeDistanceBehind(*input.local_costmap, input.pose, std::min(0.1, target_ - moved), config_.footprint_radius) <
-          std::min(0.1, target_ - moved) - 1e-9)
+  if (input.local_costmap && freeDistanceBehind(*input.local_costmap, input.pose, std::min(0.1, target_ - moved),
+                                                config_.footprint_radius) < std::min(0.1, target_ - moved) - 1e-9)
   {
     std::snprintf(buf, sizeof(buf), "an obstacle appeared behind the robot after %.2f m", moved);
     message_ = buf;

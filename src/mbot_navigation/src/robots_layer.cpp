@@ -8,8 +8,7 @@ namespace mbot_navigation
 RobotsLayer::RobotsLayer(const RobotsLayerConfig& config) : config_(config)
 {
   if (!(config.prediction_time >= 0.0) || !(config.prediction_step > 0.0))
-    throw std::invalid_argument(
-        "RobotsLayerConfig: 'prediction_time' must be >= 0 [s] and 'prediction_step' > 0 [s]");
+    throw std::invalid_argument("RobotsLayerConfig: 'prediction_time' must be >= 0 [s] and 'prediction_step' > 0 [s]");
   if (config.prediction_cost >= cost::INSCRIBED)
     throw std::invalid_argument("RobotsLayerConfig: 'prediction_cost' must be < 253 (passable)");
 }
@@ -50,8 +49,7 @@ void RobotsLayer::updateBounds(const Pose2D& /*robot*/, Bounds& bounds)
   last_bounds_ = now;
 }
 
-void RobotsLayer::drawDisc(Costmap2D& master, const CellWindow& w, double x, double y, double radius,
-                           uint8_t c)
+void RobotsLayer::drawDisc(Costmap2D& master, const CellWindow& w, double x, double y, double radius, uint8_t c)
 {
   const double res = master.resolution();
   // Cell range of the disc's box, clipped to the window.

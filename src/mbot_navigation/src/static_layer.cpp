@@ -8,16 +8,15 @@ namespace mbot_navigation
 {
 uint8_t StaticLayer::interpretValue(int8_t value) const
 {
-  if (value == config_.unknown_cost_value)
-    return config_.track_unknown_space ? cost::NO_INFORMATION : cost::FREE;
+  if (value == config_.unknown_cost_value) return config_.track_unknown_space ? cost::NO_INFORMATION : cost::FREE;
   if (value >= config_.lethal_cost_threshold) return cost::LETHAL;
   if (config_.trinary_costmap || value <= 0) return cost::FREE;
   // Scaled mode, as costmap_2d: the occupancy fraction of LETHAL.
   return static_cast<uint8_t>(static_cast<double>(value) / config_.lethal_cost_threshold * cost::LETHAL);
 }
 
-void StaticLayer::setMap(unsigned width, unsigned height, double resolution, double origin_x,
-                         double origin_y, const int8_t* data)
+void StaticLayer::setMap(unsigned width, unsigned height, double resolution, double origin_x, double origin_y,
+                         const int8_t* data)
 {
   if (width == 0 || height == 0 || !(resolution > 0.0) || data == nullptr)
     throw std::invalid_argument("StaticLayer::setMap: empty map or resolution <= 0");
@@ -32,8 +31,8 @@ void StaticLayer::setMap(unsigned width, unsigned height, double resolution, dou
   if (layered_costmap_ && !layered_costmap_->isRolling())
   {
     const Costmap2D& m = layered_costmap_->costmap();
-    if (m.sizeX() != width || m.sizeY() != height || m.resolution() != resolution ||
-        m.originX() != origin_x || m.originY() != origin_y)
+    if (m.sizeX() != width || m.sizeY() != height || m.resolution() != resolution || m.originX() != origin_x ||
+        m.originY() != origin_y)
       layered_costmap_->resizeMap(width, height, resolution, origin_x, origin_y);
   }
 }

@@ -27,8 +27,7 @@ void DwaConfig::validate() const
   require(min_vel_theta >= 0.0 && min_vel_theta <= max_vel_theta, "min_vel_theta", min_vel_theta,
           "in [0, max_vel_theta]");
   require(acc_lim_x > 0.0, "acc_lim_x", acc_lim_x, "> 0");
-  require(acc_lim_y > 0.0 || max_vel_y == min_vel_y, "acc_lim_y", acc_lim_y,
-          "> 0 when v_y is sampled");
+  require(acc_lim_y > 0.0 || max_vel_y == min_vel_y, "acc_lim_y", acc_lim_y, "> 0 when v_y is sampled");
   require(acc_lim_theta > 0.0, "acc_lim_theta", acc_lim_theta, "> 0");
   require(trans_stopped_vel >= 0.0, "trans_stopped_vel", trans_stopped_vel, ">= 0");
   require(theta_stopped_vel >= 0.0, "theta_stopped_vel", theta_stopped_vel, ">= 0");
@@ -37,8 +36,7 @@ void DwaConfig::validate() const
   require(controller_frequency > 0.0, "controller_frequency", controller_frequency, "> 0 [Hz]");
   require(sim_time > 0.0, "sim_time", sim_time, "> 0 [s]");
   require(sim_granularity > 0.0, "sim_granularity", sim_granularity, "> 0 [m]");
-  require(angular_sim_granularity > 0.0, "angular_sim_granularity", angular_sim_granularity,
-          "> 0 [rad]");
+  require(angular_sim_granularity > 0.0, "angular_sim_granularity", angular_sim_granularity, "> 0 [rad]");
   require(vx_samples >= 1, "vx_samples", vx_samples, ">= 1");
   require(vy_samples >= 1, "vy_samples", vy_samples, ">= 1");
   require(vth_samples >= 1, "vth_samples", vth_samples, ">= 1");
@@ -48,8 +46,7 @@ void DwaConfig::validate() const
   require(twirling_scale >= 0.0, "twirling_scale", twirling_scale, ">= 0");
   require(forward_point_distance >= 0.0, "forward_point_distance", forward_point_distance, ">= 0");
   require(oscillation_reset_dist >= 0.0, "oscillation_reset_dist", oscillation_reset_dist, ">= 0");
-  require(oscillation_reset_angle >= 0.0, "oscillation_reset_angle", oscillation_reset_angle,
-          ">= 0");
+  require(oscillation_reset_angle >= 0.0, "oscillation_reset_angle", oscillation_reset_angle, ">= 0");
   require(footprint_radius > 0.0, "footprint_radius", footprint_radius,
           "> 0 [m] (the URDF's footprint radius, mbot_description RobotModel::footprint_radius)");
 }

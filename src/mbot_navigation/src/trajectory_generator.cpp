@@ -27,9 +27,8 @@ Pose2D integratePose(const Pose2D& pose, const Twist2D& velocity, double dt)
 }
 
 TrajectoryGenerator::TrajectoryGenerator(const DwaConfig& config)
-  : config_(config), min_vel_trans_(config.min_vel_trans), min_vel_theta_(config.min_vel_theta)
-{
-}
+    : config_(config), min_vel_trans_(config.min_vel_trans), min_vel_theta_(config.min_vel_theta)
+{}
 
 std::vector<double> TrajectoryGenerator::sampleRange(double min, double max, int num_samples)
 {
@@ -101,8 +100,7 @@ bool TrajectoryGenerator::isAdmissible(const Twist2D& sample) const
   return vmag - kEps <= config_.max_vel_trans;
 }
 
-bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
-                                   Trajectory& trajectory) const
+bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample, Trajectory& trajectory) const
 {
   trajectory.velocity = sample;
   trajectory.cost = -1.0;
@@ -113,9 +111,8 @@ bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
   // angular_sim_granularity, so that no obstacle cell is stepped over.
   const double distance = std::hypot(sample.vx, sample.vy) * config_.sim_time;
   const double angle = std::fabs(sample.wz) * config_.sim_time;
-  const int steps = std::max(
-      1, static_cast<int>(std::ceil(std::max(distance / config_.sim_granularity,
-                                             angle / config_.angular_sim_granularity))));
+  const int steps = std::max(1, static_cast<int>(std::ceil(std::max(distance / config_.sim_granularity,
+                                                                    angle / config_.angular_sim_granularity))));
   const double dt = config_.sim_time / steps;
   trajectory.time_delta = dt;
 
@@ -142,8 +139,7 @@ bool TrajectoryGenerator::generate(const Pose2D& pose, const Twist2D& sample,
   return true;
 }
 
-void TrajectoryGenerator::generateBraking(const Pose2D& pose, const Twist2D& command,
-                                          Trajectory& trajectory) const
+void TrajectoryGenerator::generateBraking(const Pose2D& pose, const Twist2D& command, Trajectory& trajectory) const
 {
   trajectory.velocity = command;
   trajectory.cost = -1.0;

@@ -86,7 +86,7 @@ class Contacts(object):
     def _on_contact(self, msg):
         if msg.body_a in self.robots or msg.body_b in self.robots:
             self.events.append("%s-%s at (%.2f, %.2f), t = %.2f" % (msg.body_a, msg.body_b, msg.position.x,
-                                                                   msg.position.y, msg.header.stamp.to_sec()))
+                                                                    msg.position.y, msg.header.stamp.to_sec()))
 
 
 def wait_for_map(timeout=60.0):

@@ -239,7 +239,7 @@ TEST(AStar, UTrapOptimalAndSmoothedNotLonger)
   const PlanResult s = smooth.makePlan(m, at(m, 20, 20), at(m, 35, 20));
   expectValidPath(m, s);
   EXPECT_LE(lengthCells(s), grid.lastStats().grid_path_length + 1e-9);
-  EXPECT_LT(lengthCells(s), optimal - 0.5);  // the staircases are cut
+  EXPECT_LT(lengthCells(s), optimal - 0.5);                           // the staircases are cut
   EXPECT_EQ(smooth.lastStats().expanded, grid.lastStats().expanded);  // smoothing does not change the search
 }
 

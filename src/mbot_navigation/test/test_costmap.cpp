@@ -213,10 +213,10 @@ TEST_F(ObstacleLayerTest, ObstacleRangeAndInvalidRanges)
   ScanObservation s;
   s.origin_x = 0.525;
   s.origin_y = 0.525;
-  s.beams.push_back({0.0, 2.4});                          // marked (<= obstacle_range 2.5)
-  s.beams.push_back({M_PI / 2, 2.7});                     // not marked (> 2.5), but clears
-  s.beams.push_back({M_PI / 4, std::nan("")});            // ignored
-  s.beams.push_back({M_PI / 4, -kInf});                   // ignored (REP-117: too close)
+  s.beams.push_back({0.0, 2.4});                // marked (<= obstacle_range 2.5)
+  s.beams.push_back({M_PI / 2, 2.7});           // not marked (> 2.5), but clears
+  s.beams.push_back({M_PI / 4, std::nan("")});  // ignored
+  s.beams.push_back({M_PI / 4, -kInf});         // ignored (REP-117: too close)
   scan(s);
   EXPECT_EQ(at(0.525 + 2.4, 0.525), cost::LETHAL);
   EXPECT_EQ(at(0.525, 0.525 + 2.7), cost::FREE);
@@ -326,7 +326,8 @@ TEST(LayeredCostmap, IncrementalUpdatesEqualAFullRecompute)
     ScanObservation s;
     s.origin_x = robot.x;
     s.origin_y = robot.y;
-    for (int b = 0; b < 40; ++b) s.beams.push_back({0.16 * b + u(rng), rng() % 8 == 0 ? kInf : 2.8 * std::fabs(u(rng))});
+    for (int b = 0; b < 40; ++b)
+      s.beams.push_back({0.16 * b + u(rng), rng() % 8 == 0 ? kInf : 2.8 * std::fabs(u(rng))});
     obs.addObservation(s);
     costmap.updateMap(robot);
     ASSERT_FALSE(costmap.lastWindow().empty());
@@ -379,11 +380,11 @@ TEST(RobotsLayer, MarksFootprintAndPredictedMotionAndForgetsOldPoses)
 
   // Queries at cell centres (x.x25), so that no point sits on a cell boundary.
   EXPECT_EQ(costAt(m, 2.025, 2.025), cost::LETHAL);
-  EXPECT_EQ(costAt(m, 2.175, 2.025), cost::LETHAL);  // 0.18 m: inside the 0.2 m footprint
-  EXPECT_EQ(costAt(m, 2.525, 2.025), 200);           // where it will be in 1 s
-  EXPECT_EQ(costAt(m, 2.775, 2.025), 200);           // 0.28 m beyond: radius 0.2 + our 0.1 m
-  EXPECT_EQ(costAt(m, 2.875, 2.025), cost::FREE);    // 0.38 m beyond: outside the sweep
-  EXPECT_EQ(costAt(m, 1.675, 2.025), cost::FREE);    // behind it: 0.33 m > 0.2 m footprint
+  EXPECT_EQ(costAt(m, 2.175, 2.025), cost::LETHAL);     // 0.18 m: inside the 0.2 m footprint
+  EXPECT_EQ(costAt(m, 2.525, 2.025), 200);              // where it will be in 1 s
+  EXPECT_EQ(costAt(m, 2.775, 2.025), 200);              // 0.28 m beyond: radius 0.2 + our 0.1 m
+  EXPECT_EQ(costAt(m, 2.875, 2.025), cost::FREE);       // 0.38 m beyond: outside the sweep
+  EXPECT_EQ(costAt(m, 1.675, 2.025), cost::FREE);       // behind it: 0.33 m > 0.2 m footprint
   EXPECT_LT(costAt(m, 2.525, 2.025), cost::INSCRIBED);  // passable
 
   // It moved away: the old cells are free again.

@@ -178,7 +178,7 @@ TEST(TrajectoryGenerator, SamplesTheDynamicWindow)
   const DwaConfig c = diffDriveConfig();
   TrajectoryGenerator generator(c);
   generator.initialise(Twist2D{0.3, 0.0, 0.0});
-  const double dv = c.acc_lim_x * c.simPeriod();    // 0.125 m/s
+  const double dv = c.acc_lim_x * c.simPeriod();      // 0.125 m/s
   const double dw = c.acc_lim_theta * c.simPeriod();  // 0.16 rad/s
   double min_x = 1e9, max_x = -1e9, min_w = 1e9, max_w = -1e9;
   for (const Twist2D& s : generator.samples())
@@ -206,8 +206,7 @@ TEST(TrajectoryGenerator, SamplesTheDynamicWindow)
   EXPECT_NEAR(t.poses.back().x, 1.0 + 0.5 * c.sim_time, 1e-9);
   EXPECT_NEAR(t.time_delta * (t.poses.size() - 1), c.sim_time, 1e-9);
   for (size_t i = 1; i < t.poses.size(); ++i)
-    EXPECT_LE(std::hypot(t.poses[i].x - t.poses[i - 1].x, t.poses[i].y - t.poses[i - 1].y),
-              c.sim_granularity + 1e-12);
+    EXPECT_LE(std::hypot(t.poses[i].x - t.poses[i - 1].x, t.poses[i].y - t.poses[i - 1].y), c.sim_granularity + 1e-12);
   // Too slow to move: rejected.
   EXPECT_FALSE(generator.generate(Pose2D{}, Twist2D{0.05, 0.0, 0.1}, t));
 }
@@ -329,17 +328,16 @@ TEST(DwaPlanner, StopsAtTheGoalWithinTolerances)
   planner.setPlan(straightPlan(0.5, 1.0, 3.0, 2.5, goal_yaw));
   const ClosedLoopRun run = simulate(planner, map, Pose2D{0.5, 1.0, 0.0}, 600);  // 30 s at most
 
-  ASSERT_TRUE(run.reached) << "not at the goal after 30 s: (" << run.final_pose.x << ", "
-                           << run.final_pose.y << ", " << run.final_pose.theta << ")";
+  ASSERT_TRUE(run.reached) << "not at the goal after 30 s: (" << run.final_pose.x << ", " << run.final_pose.y << ", "
+                           << run.final_pose.theta << ")";
   for (const LocalPlanResult& r : run.results) ASSERT_TRUE(r.ok) << r.error;
   EXPECT_LE(std::hypot(run.final_pose.x - 3.0, run.final_pose.y - 2.5), c.xy_goal_tolerance);
   EXPECT_LE(std::fabs(mbot_common::angleDiff(run.final_pose.theta, goal_yaw)), c.yaw_goal_tolerance);
   EXPECT_LE(std::fabs(run.final_velocity.vx), c.trans_stopped_vel);
   EXPECT_LE(std::fabs(run.final_velocity.wz), c.theta_stopped_vel);
   // It turned in place to the goal yaw (the plan arrives heading ~31 deg, the goal is 90 deg).
-  const bool rotated = std::any_of(run.results.begin(), run.results.end(), [](const LocalPlanResult& r) {
-    return r.state == LocalPlannerState::ROTATING;
-  });
+  const bool rotated = std::any_of(run.results.begin(), run.results.end(),
+                                   [](const LocalPlanResult& r) { return r.state == LocalPlannerState::ROTATING; });
   EXPECT_TRUE(rotated);
   expectWithinAccelerationLimits(run, c);
 
@@ -394,7 +392,7 @@ TEST(DwaPlanner, StartsFromRestWithLowAccelerationLimits)
   const ClosedLoopRun run = simulate(planner, world, Pose2D{0.5, 2.0, 0.0}, 40);  // 2 s
   for (const LocalPlanResult& r : run.results) ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(run.commands.front().vx, c.acc_lim_x * c.simPeriod(), 1e-12);  // full acceleration
-  EXPECT_GE(run.commands.back().vx, 0.95 * c.max_vel_x);  // 0.5 s to full speed, then cruising
+  EXPECT_GE(run.commands.back().vx, 0.95 * c.max_vel_x);                     // 0.5 s to full speed, then cruising
   expectWithinAccelerationLimits(run, c);
 }
 
@@ -419,8 +417,8 @@ TEST(DwaPlanner, OmniRobotSidestepsBackOntoThePlan)
   for (const LocalPlanResult& r : strafe.results) ASSERT_TRUE(r.ok) << r.error;
   double strafed = 0.0;  // lateral distance covered with v_y [m], towards the plan is negative
   for (const Twist2D& cmd : strafe.commands) strafed += cmd.vy * omni.simPeriod();
-  EXPECT_LT(strafed, -0.15);             // most of the 0.25 m, sideways
-  EXPECT_LT(max_yaw(strafe), 0.1);       // without turning much
+  EXPECT_LT(strafed, -0.15);        // most of the 0.25 m, sideways
+  EXPECT_LT(max_yaw(strafe), 0.1);  // without turning much
   expectWithinAccelerationLimits(strafe, omni);
 
   const DwaConfig diff = mbotOmniConfig(false);

@@ -35,8 +35,7 @@ TEST(InflationLayer, SquaredDistanceTransformMatchesBruteForce)
     const auto d2 = bruteForceSquaredDistances(g);
     for (size_t i = 0; i < d2.size(); ++i)
     {
-      const int expected = d2[i] < 0 || d2[i] > R2 ? cost::FREE
-                                                    : inflation.computeCost(std::sqrt(double(d2[i])));
+      const int expected = d2[i] < 0 || d2[i] > R2 ? cost::FREE : inflation.computeCost(std::sqrt(double(d2[i])));
       ASSERT_EQ(int(grid.data()[i]), expected) << g.w << "x" << g.h << " cell " << i;
     }
   }

@@ -14,15 +14,11 @@ using namespace mbot_navigation;
 
 namespace
 {
-std::string descriptionDir()
-{
-  return ros::package::getPath("mbot_description");
-}
+std::string descriptionDir() { return ros::package::getPath("mbot_description"); }
 
 NavParams read(const std::string& ns, ParamWarnings& warnings)
 {
-  return readNavParams(ros::NodeHandle("/" + ns), ros::NodeHandle("/" + ns + "/move_base"), descriptionDir(),
-                       warnings);
+  return readNavParams(ros::NodeHandle("/" + ns), ros::NodeHandle("/" + ns + "/move_base"), descriptionDir(), warnings);
 }
 
 /// The error text of reading `ns` ("" when it loads).
@@ -71,7 +67,7 @@ TEST(MoveBaseParams, TutorialSetLoadsWithWarningsOnly)
   EXPECT_FALSE(p.local_costmap.static_map);
   EXPECT_TRUE(p.local_costmap.costmap.rolling_window);
   EXPECT_NEAR(p.global_costmap.costmap.robot_radius, std::hypot(0.12, 0.12) + 0.01, 1e-9);  // footprint + padding
-  EXPECT_EQ(p.global_costmap.scan_topic, "scan");  // from observation_sources
+  EXPECT_EQ(p.global_costmap.scan_topic, "scan");                                           // from observation_sources
   EXPECT_DOUBLE_EQ(p.global_costmap.obstacle_layer.obstacle_range, 2.5);
   EXPECT_DOUBLE_EQ(p.global_costmap.inflation_layer.inflation_radius, 0.55);
   EXPECT_DOUBLE_EQ(p.local_costmap.inflation_layer.cost_scaling_factor, 5.0);
@@ -85,17 +81,18 @@ TEST(MoveBaseParams, TutorialSetLoadsWithWarningsOnly)
        {"/robot_0/move_base/conservative_reset_dist", "/robot_0/move_base/shutdown_costmaps",
         "/robot_0/move_base/NavfnROS/default_tolerance", "/robot_0/move_base/NavfnROS/visualize_potential",
         "/robot_0/move_base/DWAPlannerROS/publish_traj_pc", "/robot_0/move_base/DWAPlannerROS/stop_time_buffer",
-        "/robot_0/move_base/DWAPlannerROS/controller_frequency", "/robot_0/move_base/global_costmap/always_send_full_costmap",
+        "/robot_0/move_base/DWAPlannerROS/controller_frequency",
+        "/robot_0/move_base/global_costmap/always_send_full_costmap",
         "/robot_0/move_base/global_costmap/laser_scan_sensor/sensor_frame",
         "/robot_0/move_base/local_costmap/laser_scan_sensor/expected_update_rate",
         "/robot_0/move_base/local_costmap/global_frame", "/robot_0/move_base/global_costmap/footprint"})
     EXPECT_TRUE(warned(warnings, key)) << key;
   // Exactly one warning per ignored key (nothing is reported twice).
-  for (const std::string& w : warnings)
-    EXPECT_EQ(std::count(warnings.begin(), warnings.end(), w), 1) << w;
+  for (const std::string& w : warnings) EXPECT_EQ(std::count(warnings.begin(), warnings.end(), w), 1) << w;
   // Implemented keys give no warning.
-  for (const std::string& key : {"/robot_0/move_base/DWAPlannerROS/max_vel_x", "/robot_0/move_base/controller_frequency",
-                                 "/robot_0/move_base/global_costmap/inflation_radius"})
+  for (const std::string& key :
+       {"/robot_0/move_base/DWAPlannerROS/max_vel_x", "/robot_0/move_base/controller_frequency",
+        "/robot_0/move_base/global_costmap/inflation_radius"})
     EXPECT_FALSE(warned(warnings, key)) << key;
 }
 

@@ -24,10 +24,7 @@ namespace
 constexpr double kPi = 3.14159265358979;
 constexpr double kRadius = 0.15;  // mbot's footprint radius [m]
 
-bool contains(const std::string& text, const std::string& part)
-{
-  return text.find(part) != std::string::npos;
-}
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 /// A 10 x 10 m occupancy map (0.05 m cells, origin (-5, -5)) with outer walls and a wall at
 /// x = 0 that has a 1.2 m door at y in [-0.6, 0.6] (or no door).

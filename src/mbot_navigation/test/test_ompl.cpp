@@ -44,8 +44,7 @@ void inflateInscribed(Costmap2D& map)
         for (int dx = -r; dx <= r; ++dx)
         {
           const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= static_cast<int>(map.sizeX()) || ny >= static_cast<int>(map.sizeY()))
-            continue;
+          if (nx < 0 || ny < 0 || nx >= static_cast<int>(map.sizeX()) || ny >= static_cast<int>(map.sizeY())) continue;
           if (std::hypot(dx, dy) * map.resolution() <= kRadius && map.cost(nx, ny) < cost::INSCRIBED)
             map.setCost(nx, ny, cost::INSCRIBED);
         }
@@ -134,8 +133,7 @@ int costAt(const Costmap2D& map, double x, double y)
 double pathLength(const std::vector<Pose2D>& path)
 {
   double len = 0.0;
-  for (size_t i = 1; i < path.size(); ++i)
-    len += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
+  for (size_t i = 1; i < path.size(); ++i) len += std::hypot(path[i].x - path[i - 1].x, path[i].y - path[i - 1].y);
   return len;
 }
 
@@ -350,8 +348,7 @@ TEST(OmplPlanner, FailsWithinTheTimeLimitWhenTheGoalIsWalledIn)
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_FALSE(r.ok);
     EXPECT_TRUE(r.path.empty());
-    EXPECT_NE(r.error.find("found no path from (1.00, 1.00) to (8.80, 1.00) within 0.30 s"),
-              std::string::npos)
+    EXPECT_NE(r.error.find("found no path from (1.00, 1.00) to (8.80, 1.00) within 0.30 s"), std::string::npos)
         << r.error;
     EXPECT_LT(elapsed, config.time_limit + 1.0);  // the limit holds (generous for a loaded machine)
   }

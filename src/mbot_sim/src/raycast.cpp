@@ -58,7 +58,7 @@ inline Float selectNoBranch(bool pick, Float a, Float b)
   Bits ib;
   std::memcpy(&ia, &a, sizeof ia);
   std::memcpy(&ib, &b, sizeof ib);
-  const Bits mask = Bits{ 0 } - static_cast<Bits>(pick);
+  const Bits mask = Bits{0} - static_cast<Bits>(pick);
   const Bits bits = (ia & mask) | (ib & ~mask);
   Float out;
   std::memcpy(&out, &bits, sizeof out);
@@ -89,8 +89,7 @@ void distanceTransform1d(const double* f, int n, double* d, int* v, double* z)
   k = 0;
   for (int q = 0; q < n; ++q)
   {
-    while (z[k + 1] < q)
-      ++k;
+    while (z[k + 1] < q) ++k;
     d[q] = (double(q) - v[k]) * (double(q) - v[k]) + f[v[k]];
   }
 }
@@ -101,23 +100,22 @@ void distanceTransform1d(const double* f, int n, double* d, int* v, double* z)
 // GridRaycaster
 // =============================================================================================
 
-GridRaycaster::GridRaycaster(std::vector<uint8_t> occupied, unsigned size_x, unsigned size_y,
-                             double resolution, double origin_x, double origin_y)
-  : size_x_(size_x)
-  , size_y_(size_y)
-  , resolution_(resolution)
-  , inv_resolution_(1.0 / resolution)
-  , origin_x_(origin_x)
-  , origin_y_(origin_y)
-  , occupied_(std::move(occupied))
+GridRaycaster::GridRaycaster(std::vector<uint8_t> occupied, unsigned size_x, unsigned size_y, double resolution,
+                             double origin_x, double origin_y)
+    : size_x_(size_x),
+      size_y_(size_y),
+      resolution_(resolution),
+      inv_resolution_(1.0 / resolution),
+      origin_x_(origin_x),
+      origin_y_(origin_y),
+      occupied_(std::move(occupied))
 {
   if (!(resolution > 0.0))
-    throw std::invalid_argument("GridRaycaster: resolution must be > 0 [m], got " +
-                                std::to_string(resolution));
+    throw std::invalid_argument("GridRaycaster: resolution must be > 0 [m], got " + std::to_string(resolution));
   if (occupied_.size() != static_cast<size_t>(size_x) * size_y)
     throw std::invalid_argument("GridRaycaster: occupied has " + std::to_string(occupied_.size()) +
-                                " cells, expected size_x * size_y = " + std::to_string(size_x) +
-                                " * " + std::to_string(size_y));
+                                " cells, expected size_x * size_y = " + std::to_string(size_x) + " * " +
+                                std::to_string(size_y));
   computeClearance();
   extractWallFaces();
 }
@@ -152,8 +150,7 @@ constexpr double kFar = 1e20;  // "no occupied cell": finite, as the transform n
 
 /// Step 1: per cell, g^2 of the gap to the nearest occupied cell of its line (rows when
 /// along_x, columns otherwise) looking one way, or kFar.
-std::vector<double> lineGaps(const std::vector<uint8_t>& occupied, int w, int h, bool along_x,
-                             Look look)
+std::vector<double> lineGaps(const std::vector<uint8_t>& occupied, int w, int h, bool along_x, Look look)
 {
   std::vector<double> gap2(occupied.size(), kFar);
   const int lines = along_x ? h : w;
@@ -170,18 +167,14 @@ std::vector<double> lineGaps(const std::vector<uint8_t>& occupied, int w, int h,
     if (look == Look::kAhead)
       for (int i = len - 1, next = -1; i >= 0; --i)  // nearest occupied at or after i
       {
-        if (occupied[at(line, i)])
-          next = i;
-        if (next >= 0)
-          store(at(line, i), next - i);
+        if (occupied[at(line, i)]) next = i;
+        if (next >= 0) store(at(line, i), next - i);
       }
     else
       for (int i = 0, prev = -1; i < len; ++i)  // nearest occupied at or before i
       {
-        if (occupied[at(line, i)])
-          prev = i;
-        if (prev >= 0)
-          store(at(line, i), i - prev);
+        if (occupied[at(line, i)]) prev = i;
+        if (prev >= 0) store(at(line, i), i - prev);
       }
   }
   return gap2;
@@ -203,15 +196,12 @@ void spreadAcrossLines(std::vector<double>& d2, int w, int h, bool gaps_along_x)
     for (int i = 0; i < len; ++i)  // the 3-wide min filter
     {
       double m = d2[at(line, i)];
-      if (i > 0)
-        m = std::min(m, d2[at(line, i - 1)]);
-      if (i + 1 < len)
-        m = std::min(m, d2[at(line, i + 1)]);
+      if (i > 0) m = std::min(m, d2[at(line, i - 1)]);
+      if (i + 1 < len) m = std::min(m, d2[at(line, i + 1)]);
       in[i] = m;
     }
     distanceTransform1d(in.data(), len, out.data(), v.data(), z.data());
-    for (int i = 0; i < len; ++i)
-      d2[at(line, i)] = out[i];
+    for (int i = 0; i < len; ++i) d2[at(line, i)] = out[i];
   }
 }
 
@@ -227,8 +217,7 @@ std::vector<uint8_t> quantizeClearance(const std::vector<double>& d2)
   return units;
 }
 
-std::vector<uint8_t> clearanceMap(const std::vector<uint8_t>& occupied, int w, int h,
-                                  bool along_x, Look look)
+std::vector<uint8_t> clearanceMap(const std::vector<uint8_t>& occupied, int w, int h, bool along_x, Look look)
 {
   std::vector<double> d2 = lineGaps(occupied, w, h, along_x, look);
   spreadAcrossLines(d2, w, h, along_x);
@@ -240,8 +229,7 @@ void GridRaycaster::computeClearance()
 {
   const int w = static_cast<int>(size_x_);
   const int h = static_cast<int>(size_y_);
-  if (occupied_.empty())
-    return;  // an empty grid: every ray reads max range, no map needed
+  if (occupied_.empty()) return;  // an empty grid: every ray reads max range, no map needed
   const std::vector<uint8_t> right = clearanceMap(occupied_, w, h, true, Look::kAhead);
   const std::vector<uint8_t> left = clearanceMap(occupied_, w, h, true, Look::kBehind);
   const std::vector<uint8_t> up = clearanceMap(occupied_, w, h, false, Look::kAhead);
@@ -249,10 +237,9 @@ void GridRaycaster::computeClearance()
   // Every occupied cell is at or right of C, or at or left of it: the nearest of all is the
   // nearer of the two.
   clearance_.resize(occupied_.size());
-  for (size_t i = 0; i < occupied_.size(); ++i)
-    clearance_[i] = std::min(right[i], left[i]);
-  const std::vector<uint8_t>* horizontal[4] = { &right, &left, &right, &left };  // bit 0: dir_x < 0
-  const std::vector<uint8_t>* vertical[4] = { &up, &up, &down, &down };         // bit 1: dir_y < 0
+  for (size_t i = 0; i < occupied_.size(); ++i) clearance_[i] = std::min(right[i], left[i]);
+  const std::vector<uint8_t>* horizontal[4] = {&right, &left, &right, &left};  // bit 0: dir_x < 0
+  const std::vector<uint8_t>* vertical[4] = {&up, &up, &down, &down};          // bit 1: dir_y < 0
   // The quadrant maps get a border of one free cell all around (stride w + 2), which lets the
   // tracer skip bounds checks (see longSteps). A free cell is at least kWallCell + 1.
   for (int q = 0; q < 4; ++q)
@@ -310,11 +297,10 @@ void appendRuns(int line, int length, EdgeAt&& edge_at, std::vector<WallFace>& o
   for (int k = 0; k <= length; ++k)
   {
     const bool edge = k < length && edge_at(k);
-    if (edge && start < 0)
-      start = k;
+    if (edge && start < 0) start = k;
     if (!edge && start >= 0)
     {
-      out.push_back(WallFace{ line, start, k, 0 });
+      out.push_back(WallFace{line, start, k, 0});
       start = -1;
     }
   }
@@ -329,13 +315,17 @@ void GridRaycaster::extractWallFaces()
   std::vector<WallFace> faces[4];
   for (int x = 1; x < w; ++x)  // vertical grid lines inside the grid
   {
-    appendRuns(x, h, [&](int y) { return !occ(x - 1, y) && occ(x, y); }, faces[kFreeMinusX]);
-    appendRuns(x, h, [&](int y) { return occ(x - 1, y) && !occ(x, y); }, faces[kFreePlusX]);
+    appendRuns(
+        x, h, [&](int y) { return !occ(x - 1, y) && occ(x, y); }, faces[kFreeMinusX]);
+    appendRuns(
+        x, h, [&](int y) { return occ(x - 1, y) && !occ(x, y); }, faces[kFreePlusX]);
   }
   for (int y = 1; y < h; ++y)  // horizontal grid lines
   {
-    appendRuns(y, w, [&](int x) { return !occ(x, y - 1) && occ(x, y); }, faces[kFreeMinusY]);
-    appendRuns(y, w, [&](int x) { return occ(x, y - 1) && !occ(x, y); }, faces[kFreePlusY]);
+    appendRuns(
+        y, w, [&](int x) { return !occ(x, y - 1) && occ(x, y); }, faces[kFreeMinusY]);
+    appendRuns(
+        y, w, [&](int x) { return occ(x, y - 1) && !occ(x, y); }, faces[kFreePlusY]);
   }
 
   // Bucket by tile: a face lies on its line's tile column (row) and is copied into every tile
@@ -403,10 +393,7 @@ struct CellMaps
 };
 
 /// The clearance map of the quadrant a direction heads into (bit 0: u_x < 0, bit 1: u_y < 0).
-inline int quadrantOf(double ux, double uy)
-{
-  return (ux < 0.0 ? 1 : 0) | (uy < 0.0 ? 2 : 0);
-}
+inline int quadrantOf(double ux, double uy) { return (ux < 0.0 ? 1 : 0) | (uy < 0.0 ? 2 : 0); }
 
 /// A ray and its per-ray constants [cells].
 struct Ray
@@ -426,7 +413,7 @@ inline Ray makeRay(const CellMaps& m, double px, double py, double ux, double uy
   // goes by the sign of 1 / u, never crosses on that axis, and t_end below ignores that axis.
   ux += 0.0;
   uy += 0.0;
-  Ray r{ px, py, ux, uy, 1.0 / ux, 1.0 / uy, t_max, m.cell00[quadrantOf(ux, uy)] };
+  Ray r{px, py, ux, uy, 1.0 / ux, 1.0 / uy, t_max, m.cell00[quadrantOf(ux, uy)]};
   // Where the ray leaves the grid on each axis (+Inf for a zero component; written with
   // selects and min, no branches: this runs for every beam).
   r.t_end = std::min(r.t_end, (r.inv_ux > 0.0 ? m.w - px : -px) * r.inv_ux);
@@ -456,7 +443,7 @@ inline int cellBehind(double v, double u)
 // kept a little behind the true position (kFixedBehind): the rounding of the start and the
 // moves (truncated towards zero) then never puts it in a cell ahead of the ray, and it stays
 // far closer to the ray than the clearance margin.
-constexpr int64_t kFixedBehind = int64_t{ 1 } << 12;  // 2^-20 cells
+constexpr int64_t kFixedBehind = int64_t{1} << 12;  // 2^-20 cells
 // Beams whose long steps are interleaved, and for how many steps at most (see
 // LongSteps::runGroup). Most rays need at most 6 steps; groups of 2 to 8 and 4 to 99 steps
 // measured within noise of each other in the benchmark room.
@@ -466,8 +453,7 @@ constexpr int kLockstepSteps = 6;
 /// Coordinate v [cells] in fixed point, moved a hair behind along direction component u.
 inline int64_t toFixedBehind(double v, double u)
 {
-  return static_cast<int64_t>(v * kFixedOne) -
-         (u > 0.0 ? kFixedBehind : u < 0.0 ? -kFixedBehind : 0);
+  return static_cast<int64_t>(v * kFixedOne) - (u > 0.0 ? kFixedBehind : u < 0.0 ? -kFixedBehind : 0);
 }
 
 /// A ray during its long steps. Position in fixed point: the cell of a point is then a shift,
@@ -498,8 +484,7 @@ struct LongSteps
   void run(const uint8_t* map, ptrdiff_t stride)
   {
     while (step(map, stride) != 0)
-    {
-    }
+    {}
   }
 
   /// run() for N rays at once. Each step needs the clearance of the cell the previous step
@@ -513,13 +498,10 @@ struct LongSteps
     for (int iteration = 0; iteration < kLockstepSteps; ++iteration)
     {
       int64_t moved = 0;
-      for (int k = 0; k < N; ++k)
-        moved |= s[k].step(rays[k].map, stride);
-      if (moved == 0)
-        return;
+      for (int k = 0; k < N; ++k) moved |= s[k].step(rays[k].map, stride);
+      if (moved == 0) return;
     }
-    for (int k = 0; k < N; ++k)
-      s[k].run(rays[k].map, stride);
+    for (int k = 0; k < N; ++k) s[k].run(rays[k].map, stride);
   }
 };
 
@@ -531,11 +513,10 @@ inline void longSteps(const Ray& r, ptrdiff_t stride, RayPosition& pos)
   // the cell's boundary, where the fixed point could fall into the cell behind.
   const unsigned c = r.map[pos.cy * stride + pos.cx];
   const double t0 = pos.t + c * kClearanceUnit;
-  const int64_t room0 =
-      t0 <= r.t_end ? static_cast<int64_t>((r.t_end - t0) * (1.0 / kClearanceUnit)) + 1 : 0;
-  LongSteps s{ toFixedBehind(r.px + t0 * r.ux, r.ux), toFixedBehind(r.py + t0 * r.uy, r.uy),
-               static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne),
-               static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne), room0 };
+  const int64_t room0 = t0 <= r.t_end ? static_cast<int64_t>((r.t_end - t0) * (1.0 / kClearanceUnit)) + 1 : 0;
+  LongSteps s{toFixedBehind(r.px + t0 * r.ux, r.ux), toFixedBehind(r.py + t0 * r.uy, r.uy),
+              static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne),
+              static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne), room0};
   s.run(r.map, stride);
   pos.finished = s.room == 0;
   pos.t = t0 + (room0 - s.room) * kClearanceUnit;
@@ -608,13 +589,11 @@ inline bool walkCells(const Ray& r, ptrdiff_t stride, RayPosition& pos, double& 
       t_hit = t;
       return true;
     }
-    if (c >= kResumeLongSteps)
-      break;  // open space again
+    if (c >= kResumeLongSteps) break;  // open space again
   }
   // (Rare: the cell's coordinates from its index, counted from the border's corner.)
   const ptrdiff_t from_corner = cell + stride + 1;
-  pos = RayPosition{ t, static_cast<int>(from_corner % stride) - 1,
-                     static_cast<int>(from_corner / stride) - 1, false };
+  pos = RayPosition{t, static_cast<int>(from_corner % stride) - 1, static_cast<int>(from_corner / stride) - 1, false};
   return false;
 }
 
@@ -627,12 +606,10 @@ inline double traceRay(const Ray& r, ptrdiff_t stride, RayPosition pos)
     if (r.map[pos.cy * stride + pos.cx] >= kMinLongStep)
     {
       longSteps(r, stride, pos);
-      if (pos.finished)
-        return r.t_end;
+      if (pos.finished) return r.t_end;
     }
     double t_hit;
-    if (walkCells(r, stride, pos, t_hit))
-      return t_hit;
+    if (walkCells(r, stride, pos, t_hit)) return t_hit;
   }
 }
 }  // namespace
@@ -642,16 +619,15 @@ double GridRaycaster::cast(double x, double y, double theta, double max_range) c
   return castDirection(x, y, std::cos(theta), std::sin(theta), max_range);
 }
 
-double GridRaycaster::castDirection(double x, double y, double dir_x, double dir_y,
-                                    double max_range) const
+double GridRaycaster::castDirection(double x, double y, double dir_x, double dir_y, double max_range) const
 {
   double range = max_range;
   castFan(x, y, &dir_x, &dir_y, 1, max_range, &range);
   return range;
 }
 
-void GridRaycaster::castFan(double x, double y, const double* dir_x, const double* dir_y, int n,
-                            double max_range, double* ranges) const
+void GridRaycaster::castFan(double x, double y, const double* dir_x, const double* dir_y, int n, double max_range,
+                            double* ranges) const
 {
   if (!(max_range > 0.0) || occupied_.empty() || !std::isfinite(x) || !std::isfinite(y))
   {
@@ -661,12 +637,10 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
   // Directions must be finite: they become cell indices.
   for (int i = 0; i < n; ++i)
     if (!std::isfinite(dir_x[i]) || !std::isfinite(dir_y[i]))
-      throw std::invalid_argument("GridRaycaster: ray direction " + std::to_string(i) +
-                                  " is not finite");
+      throw std::invalid_argument("GridRaycaster: ray direction " + std::to_string(i) + " is not finite");
   const ptrdiff_t stride = static_cast<ptrdiff_t>(size_x_) + 2;
   CellMaps maps;
-  for (int q = 0; q < 4; ++q)
-    maps.cell00[q] = quadrant_clearance_[q].data() + stride + 1;
+  for (int q = 0; q < 4; ++q) maps.cell00[q] = quadrant_clearance_[q].data() + stride + 1;
   maps.stride = stride;
   maps.w = static_cast<int>(size_x_);
   maps.h = static_cast<int>(size_y_);
@@ -714,17 +688,14 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
         LongSteps& s = steps[k];
         s.move_x = static_cast<int64_t>(r.ux * kClearanceUnit * kFixedOne);
         s.move_y = static_cast<int64_t>(r.uy * kClearanceUnit * kFixedOne);
-        s.fx = fx0 + first * s.move_x -
-               (r.ux > 0.0 ? kFixedBehind : r.ux < 0.0 ? -kFixedBehind : 0);
-        s.fy = fy0 + first * s.move_y -
-               (r.uy > 0.0 ? kFixedBehind : r.uy < 0.0 ? -kFixedBehind : 0);
+        s.fx = fx0 + first * s.move_x - (r.ux > 0.0 ? kFixedBehind : r.ux < 0.0 ? -kFixedBehind : 0);
+        s.fy = fy0 + first * s.move_y - (r.uy > 0.0 ? kFixedBehind : r.uy < 0.0 ? -kFixedBehind : 0);
         s.room = room0[k] - first;
       }
       if (count == kGroup)
         LongSteps::runGroup<kGroup>(rays, steps, stride);
       else
-        for (int k = 0; k < count; ++k)
-          steps[k].run(rays[k].map, stride);
+        for (int k = 0; k < count; ++k) steps[k].run(rays[k].map, stride);
       for (int k = 0; k < count; ++k)
       {
         const Ray& r = rays[k];
@@ -735,12 +706,10 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
           continue;
         }
         // Next to a wall: the exact walk (and, rarely, more long steps after it).
-        RayPosition pos{ (room0[k] - s.room) * kClearanceUnit,
-                         static_cast<int>(s.fx >> kFixedShift),
-                         static_cast<int>(s.fy >> kFixedShift), false };
+        RayPosition pos{(room0[k] - s.room) * kClearanceUnit, static_cast<int>(s.fx >> kFixedShift),
+                        static_cast<int>(s.fy >> kFixedShift), false};
         double t_hit;
-        if (!walkCells(r, stride, pos, t_hit))
-          t_hit = traceRay(r, stride, pos);
+        if (!walkCells(r, stride, pos, t_hit)) t_hit = traceRay(r, stride, pos);
         ranges[i0 + k] = toRange(t_hit, r);
       }
     }
@@ -768,9 +737,8 @@ void GridRaycaster::castFan(double x, double y, const double* dir_x, const doubl
     // The entry point lies on the grid's edge: its cell "behind" is the border cell outside,
     // a free cell from which the walk crosses into the grid at t_start, where a wall cell is
     // hit at once.
-    const RayPosition start{ t_start,
-                             std::clamp(cellBehind(px + t_start * r.ux, r.ux), -1, maps.w),
-                             std::clamp(cellBehind(py + t_start * r.uy, r.uy), -1, maps.h), false };
+    const RayPosition start{t_start, std::clamp(cellBehind(px + t_start * r.ux, r.ux), -1, maps.w),
+                            std::clamp(cellBehind(py + t_start * r.uy, r.uy), -1, maps.h), false};
     ranges[i] = toRange(traceRay(r, stride, start), r);
   }
 }
@@ -779,8 +747,7 @@ bool GridRaycaster::occupiedAt(double x, double y) const
 {
   const double fx = std::floor((x - origin_x_) * inv_resolution_);
   const double fy = std::floor((y - origin_y_) * inv_resolution_);
-  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
-    return false;
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_) return false;
   return occupied_[static_cast<size_t>(fy) * size_x_ + static_cast<size_t>(fx)] != 0;
 }
 
@@ -788,8 +755,7 @@ double GridRaycaster::clearanceAt(double x, double y) const
 {
   const double fx = std::floor((x - origin_x_) * inv_resolution_);
   const double fy = std::floor((y - origin_y_) * inv_resolution_);
-  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
-    return 0.0;
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_) return 0.0;
   const size_t idx = static_cast<size_t>(fy) * size_x_ + static_cast<size_t>(fx);
   return clearance_[idx] * kClearanceUnit * resolution_;
 }
@@ -798,8 +764,7 @@ double GridRaycaster::clearanceAlong(double x, double y, double dir_x, double di
 {
   const double fx = std::floor((x - origin_x_) * inv_resolution_);
   const double fy = std::floor((y - origin_y_) * inv_resolution_);
-  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_)
-    return 0.0;
+  if (fx < 0.0 || fy < 0.0 || fx >= size_x_ || fy >= size_y_) return 0.0;
   const size_t idx = (static_cast<size_t>(fy) + 1) * (size_x_ + 2) + static_cast<size_t>(fx) + 1;
   const int quadrant = (dir_x < 0.0 ? 1 : 0) | (dir_y < 0.0 ? 2 : 0);
   const unsigned c = quadrant_clearance_[quadrant][idx];
@@ -813,8 +778,7 @@ double GridRaycaster::clearanceAlong(double x, double y, double dir_x, double di
 ShapeSet::ShapeSet(double bucket_size) : bucket_size_(bucket_size)
 {
   if (!(bucket_size > 0.0))
-    throw std::invalid_argument("ShapeSet: bucket_size must be > 0 [m], got " +
-                                std::to_string(bucket_size));
+    throw std::invalid_argument("ShapeSet: bucket_size must be > 0 [m], got " + std::to_string(bucket_size));
 }
 
 void ShapeSet::clear()
@@ -828,18 +792,14 @@ void ShapeSet::clear()
   max_extent_ = 0.0;
 }
 
-int64_t ShapeSet::bucketIndex(double v) const
-{
-  return static_cast<int64_t>(std::floor(v / bucket_size_));
-}
+int64_t ShapeSet::bucketIndex(double v) const { return static_cast<int64_t>(std::floor(v / bucket_size_)); }
 
 namespace
 {
 /// One key for a bucket (bx, by): the low 32 bits of each index, side by side.
 inline int64_t packBucketKey(int64_t bx, int64_t by)
 {
-  const uint64_t key =
-      (static_cast<uint64_t>(bx) << 32) | (static_cast<uint64_t>(by) & 0xffffffffu);
+  const uint64_t key = (static_cast<uint64_t>(bx) << 32) | (static_cast<uint64_t>(by) & 0xffffffffu);
   return static_cast<int64_t>(key);
 }
 }  // namespace
@@ -866,11 +826,9 @@ void ShapeSet::addCircle(const Circle& c)
 
 void ShapeSet::addBox(const OrientedBox& b)
 {
-  if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.yaw) ||
-      !(b.half_length >= 0.0) || !(b.half_width >= 0.0) || !std::isfinite(b.half_length) ||
-      !std::isfinite(b.half_width))
-    throw std::invalid_argument(
-        "ShapeSet::addBox: x, y, yaw must be finite and half sizes >= 0 [m]");
+  if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.yaw) || !(b.half_length >= 0.0) ||
+      !(b.half_width >= 0.0) || !std::isfinite(b.half_length) || !std::isfinite(b.half_width))
+    throw std::invalid_argument("ShapeSet::addBox: x, y, yaw must be finite and half sizes >= 0 [m]");
   PreparedBox p;
   p.box = b;
   p.cos_yaw = std::cos(b.yaw);
@@ -880,10 +838,7 @@ void ShapeSet::addBox(const OrientedBox& b)
   ++count_;
 }
 
-size_t ShapeSet::size() const
-{
-  return count_;
-}
+size_t ShapeSet::size() const { return count_; }
 
 // =============================================================================================
 // castScan
@@ -941,15 +896,15 @@ struct BeamFan
   bool parallel;  ///< increment ~ 0: every beam points the same way
 
   BeamFan(double first_angle, double increment, int n)
-    : first(std::remainder(first_angle, kTwoPi))  // into [-pi, pi]: keeps the sweep's winding small
-    , sign(increment < 0.0 ? -1.0 : 1.0)
-    , step(std::abs(increment))
-    , inv_step(step > 0.0 ? 1.0 / step : 0.0)
-    , span((n - 1) * step)
-    , beams(n)
-    , parallel(step < 1e-12)
-  {
-  }
+      : first(std::remainder(first_angle, kTwoPi))  // into [-pi, pi]: keeps the sweep's winding small
+        ,
+        sign(increment < 0.0 ? -1.0 : 1.0),
+        step(std::abs(increment)),
+        inv_step(step > 0.0 ? 1.0 / step : 0.0),
+        span((n - 1) * step),
+        beams(n),
+        parallel(step < 1e-12)
+  {}
 };
 
 /// Calls visit(i) for every beam i whose angle lies in [lo, hi] (world angles [rad], any
@@ -968,8 +923,7 @@ void forEachBeamBetween(const BeamFan& fan, double lo, double hi, Visit&& visit)
   // Angles relative to beam 0, measured in the direction the beams advance.
   double a = (lo - fan.first) * fan.sign;
   double b = (hi - fan.first) * fan.sign;
-  if (a > b)
-    std::swap(a, b);
+  if (a > b) std::swap(a, b);
   const double turns = floorToInt(a * (1.0 / kTwoPi));  // wind a into [0, 2 pi)
   a -= turns * kTwoPi;
   b -= turns * kTwoPi;
@@ -978,13 +932,11 @@ void forEachBeamBetween(const BeamFan& fan, double lo, double hi, Visit&& visit)
   for (double shift = -kTwoPi; a + shift <= fan.span; shift += kTwoPi)
   {
     const double hi_i = std::min((b + shift) * fan.inv_step, fan.beams - 1.0);
-    if (hi_i < 0.0)
-      continue;
+    if (hi_i < 0.0) continue;
     const double lo_i = (a + shift) * fan.inv_step;
     const int i0 = lo_i <= 0.0 ? 0 : ceilToInt(lo_i);
     const int i1 = floorToInt(hi_i);
-    for (int i = i0; i <= i1; ++i)
-      visit(i);
+    for (int i = i0; i <= i1; ++i) visit(i);
   }
 }
 
@@ -1016,8 +968,7 @@ struct ScanScratch
   const BeamLayout& layout(const ScanSpec& spec)
   {
     for (const BeamLayout& l : layouts)
-      if (l.matches(spec))
-        return l;
+      if (l.matches(spec)) return l;
     constexpr size_t kMaxLayouts = 8;  // beyond that, replace them in turn
     if (layouts.size() < kMaxLayouts)
       layouts.emplace_back();
@@ -1057,25 +1008,21 @@ void sweepCircle(const ScanView& scan, const Circle& c)
   const double my = c.y - scan.sy;
   const double d2 = mx * mx + my * my;
   const double r2 = c.radius * c.radius;
-  if (d2 <= r2)
-    return scan.sensorInsideShape();
+  if (d2 <= r2) return scan.sensorInsideShape();
   const double d = std::sqrt(d2);
   const double nearest = d - c.radius;  // no beam can meet the circle closer than this
-  if (nearest >= scan.range_max)
-    return;
+  if (nearest >= scan.range_max) return;
   // Seen from the sensor the circle covers bearing +- asin(r / d). r / sqrt(d^2 - r^2) (the
   // tangent of that angle) is a little wider and needs no asin: fine, since every beam in
   // the interval gets the exact test. (Capped at pi/2, which asin never exceeds.)
   const double half = std::min(c.radius / std::sqrt(d2 - r2), 0.5 * kPi) + kApproxAtan2Error;
   const double bearing = approxAtan2(my, mx);
   forEachBeamBetween(scan.fan, bearing - half, bearing + half, [&](int i) {
-    if (nearest >= scan.range[i])
-      return;  // this beam already has a closer return (a wall or another shape)
+    if (nearest >= scan.range[i]) return;  // this beam already has a closer return (a wall or another shape)
     // Ray-circle: closest approach at b along the beam; the entry lies sqrt(disc) before it.
     const double b = mx * scan.dir_x[i] + my * scan.dir_y[i];
     const double disc = b * b - (d2 - r2);
-    if (disc < 0.0 || b < 0.0)
-      return;
+    if (disc < 0.0 || b < 0.0) return;
     scan.range[i] = std::min(scan.range[i], b - std::sqrt(disc));
   });
 }
@@ -1086,21 +1033,19 @@ inline double rayBox(double lx, double ly, double ux, double uy, double hl, doub
 {
   double t_in = 0.0;
   double t_out = kInf;
-  const double p[2] = { lx, ly };
-  const double u[2] = { ux, uy };
-  const double half[2] = { hl, hw };
+  const double p[2] = {lx, ly};
+  const double u[2] = {ux, uy};
+  const double half[2] = {hl, hw};
   for (int a = 0; a < 2; ++a)
   {
     if (u[a] == 0.0)
     {
-      if (std::abs(p[a]) > half[a])
-        return kInf;
+      if (std::abs(p[a]) > half[a]) return kInf;
       continue;
     }
     double t0 = (-half[a] - p[a]) / u[a];
     double t1 = (half[a] - p[a]) / u[a];
-    if (t0 > t1)
-      std::swap(t0, t1);
+    if (t0 > t1) std::swap(t0, t1);
     t_in = std::max(t_in, t0);
     t_out = std::min(t_out, t1);
   }
@@ -1117,11 +1062,9 @@ void sweepBox(const ScanView& scan, const OrientedBox& b, double cos_yaw, double
   const double ly = -(-sin_yaw * mx + cos_yaw * my);
   const double gap_x = std::abs(lx) - b.half_length;
   const double gap_y = std::abs(ly) - b.half_width;
-  if (gap_x <= 0.0 && gap_y <= 0.0)
-    return scan.sensorInsideShape();
+  if (gap_x <= 0.0 && gap_y <= 0.0) return scan.sensorInsideShape();
   const double nearest = std::hypot(std::max(gap_x, 0.0), std::max(gap_y, 0.0));
-  if (nearest >= scan.range_max)
-    return;
+  if (nearest >= scan.range_max) return;
   // The box covers the bearings between its extreme corners. The sensor is outside the
   // (convex) box, so that cone is narrower than pi and contains the centre's bearing: measure
   // the corners' bearings relative to the centre's and take the smallest and largest.
@@ -1140,8 +1083,7 @@ void sweepBox(const ScanView& scan, const OrientedBox& b, double cos_yaw, double
   const double bearing = approxAtan2(my, mx);
   const double pad = 2.0 * kApproxAtan2Error;
   forEachBeamBetween(scan.fan, bearing + lo - pad, bearing + hi + pad, [&](int i) {
-    if (nearest >= scan.range[i])
-      return;
+    if (nearest >= scan.range[i]) return;
     const double ux = cos_yaw * scan.dir_x[i] + sin_yaw * scan.dir_y[i];  // beam in box frame
     const double uy = -sin_yaw * scan.dir_x[i] + cos_yaw * scan.dir_y[i];
     scan.range[i] = std::min(scan.range[i], rayBox(lx, ly, ux, uy, b.half_length, b.half_width));
@@ -1183,16 +1125,15 @@ struct SweepScratch
 {
   std::vector<double> inv_x;  ///< per beam, 1 / direction (+Inf for a zero component)
   std::vector<double> inv_y;
-  std::vector<double> t_end;  ///< per beam, max range or where it leaves the grid [cells]
-  std::vector<double> best;   ///< per beam, nearest hit so far, or t_end [cells]
+  std::vector<double> t_end;   ///< per beam, max range or where it leaves the grid [cells]
+  std::vector<double> best;    ///< per beam, nearest hit so far, or t_end [cells]
   std::vector<uint32_t> seen;  ///< per face id: the last scan that swept it (copies in tiles)
   uint32_t scan = 0;
 
   /// Start a new scan: a face is swept once even when it lies in several tiles.
   void nextScan(size_t faces)
   {
-    if (seen.size() < faces)
-      seen.resize(faces, 0);
+    if (seen.size() < faces) seen.resize(faces, 0);
     if (++scan == 0)  // wrapped around: forget all stamps
     {
       std::fill(seen.begin(), seen.end(), 0);
@@ -1223,8 +1164,7 @@ void sweepFace(const WallScan& s, const WallFace& f)
   const double to_lo = f.lo - (kVertical ? s.py : s.px);
   const double to_hi = f.hi - (kVertical ? s.py : s.px);
   const double along = std::max(std::max(to_lo, -to_hi), 0.0);
-  if (across * across + along * along > s.t_max2)
-    return;  // the nearest point of the face is out of range
+  if (across * across + along * along > s.t_max2) return;  // the nearest point of the face is out of range
   // Bearings of the face's ends relative to looking straight at the face: in (-pi/2, pi/2)
   // and in order, so the interval never wraps around. Then turned into world bearings.
   const double rel_lo = approxAtan2(to_lo, std::abs(across));
@@ -1251,17 +1191,15 @@ void sweepFace(const WallScan& s, const WallFace& f)
   const double* inv_a = kVertical ? s.inv_x : s.inv_y;
   const double* inv_b = kVertical ? s.inv_y : s.inv_x;
   forEachBeamBetween(s.fan, lo, hi, [&](int i) {
-    const double t = across * inv_a[i];  // where the beam crosses the face's line
-    if (!(t > 0.0 && t < s.best[i]))
-      return;  // moving away from it, or a nearer hit already
-    const double t_lo = to_lo * inv_b[i];  // where it passes the face's ends (along b)
+    const double t = across * inv_a[i];       // where the beam crosses the face's line
+    if (!(t > 0.0 && t < s.best[i])) return;  // moving away from it, or a nearer hit already
+    const double t_lo = to_lo * inv_b[i];     // where it passes the face's ends (along b)
     const double t_hi = to_hi * inv_b[i];
     const double enter = std::min(t_lo, t_hi);
     const double leave = std::max(t_lo, t_hi);
     // The walk's tie rule (see above): rows before columns.
     const bool on_face = kVertical ? (enter <= t && t < leave) : (enter < t && t <= leave);
-    if (on_face)
-      s.best[i] = t;
+    if (on_face) s.best[i] = t;
   });
 }
 
@@ -1271,29 +1209,24 @@ inline bool facesSensor(int side, double line, double px, double py)
 {
   switch (side)
   {
-    case kFreeMinusX:
-      return px < line;
-    case kFreePlusX:
-      return px > line;
-    case kFreeMinusY:
-      return py < line;
-    default:
-      return py > line;
+    case kFreeMinusX: return px < line;
+    case kFreePlusX: return px > line;
+    case kFreeMinusY: return py < line;
+    default: return py > line;
   }
 }
 
 /// Squared distance [cells^2] from (px, py) to the square tile (tx, ty), 0 inside.
 inline double squaredDistanceToTile(int tx, int ty, double px, double py)
 {
-  const double dx = std::max({ tx * kTileCells - px, px - (tx + 1) * kTileCells, 0.0 });
-  const double dy = std::max({ ty * kTileCells - py, py - (ty + 1) * kTileCells, 0.0 });
+  const double dx = std::max({tx * kTileCells - px, px - (tx + 1) * kTileCells, 0.0});
+  const double dy = std::max({ty * kTileCells - py, py - (ty + 1) * kTileCells, 0.0});
   return dx * dx + dy * dy;
 }
 }  // namespace
 
-void GridRaycaster::castScanWalls(double x, double y, const double* dir_x, const double* dir_y,
-                                  double first_angle, double increment, int n, double max_range,
-                                  double* ranges, WallMethod method) const
+void GridRaycaster::castScanWalls(double x, double y, const double* dir_x, const double* dir_y, double first_angle,
+                                  double increment, int n, double max_range, double* ranges, WallMethod method) const
 {
   if (method != WallMethod::kGridWalk &&
       sweepWalls(x, y, dir_x, dir_y, first_angle, increment, n, max_range, ranges, method))
@@ -1304,19 +1237,17 @@ void GridRaycaster::castScanWalls(double x, double y, const double* dir_x, const
 /// The sweep; false (nothing done) where the walk is to be used: odd cases the walk handles
 /// (sensor outside the grid, in a wall or exactly on a grid line, where ties at t = 0 would
 /// need the walk's rules for its starting cell), and, for kAuto, many faces in range.
-bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const double* dir_y,
-                               double first_angle, double increment, int n, double max_range,
-                               double* ranges, WallMethod method) const
+bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const double* dir_y, double first_angle,
+                               double increment, int n, double max_range, double* ranges, WallMethod method) const
 {
-  if (n <= 0 || !(max_range > 0.0) || occupied_.empty() || !std::isfinite(x) ||
-      !std::isfinite(y) || !std::isfinite(first_angle) || !std::isfinite(increment))
+  if (n <= 0 || !(max_range > 0.0) || occupied_.empty() || !std::isfinite(x) || !std::isfinite(y) ||
+      !std::isfinite(first_angle) || !std::isfinite(increment))
     return false;
   const double px = (x - origin_x_) * inv_resolution_;  // [cells], as in castFan
   const double py = (y - origin_y_) * inv_resolution_;
   const int w = static_cast<int>(size_x_);
   const int h = static_cast<int>(size_y_);
-  if (!(px > 0.0 && py > 0.0 && px < w && py < h) || px == std::floor(px) ||
-      py == std::floor(py) ||
+  if (!(px > 0.0 && py > 0.0 && px < w && py < h) || px == std::floor(px) || py == std::floor(py) ||
       occupied_[static_cast<size_t>(py) * size_x_ + static_cast<size_t>(px)])
     return false;
   const double t_max = max_range * inv_resolution_;
@@ -1335,8 +1266,7 @@ bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const do
     for (int ty = ty0; ty <= ty1; ++ty)
       faces += tile_start_[(static_cast<size_t>(ty) * tiles_x_ + tx1) * 4 + 4] -
                tile_start_[(static_cast<size_t>(ty) * tiles_x_ + tx0) * 4];
-    if (faces > kSweepMaxFacesPerBeam * n)
-      return false;
+    if (faces > kSweepMaxFacesPerBeam * n) return false;
   }
 
   // ---- per beam: the walk's ray constants (see makeRay)
@@ -1359,19 +1289,17 @@ bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const do
     scratch.t_end[i] = t_end;
     scratch.best[i] = t_end;
   }
-  if (not_finite != 0.0)
-    return false;  // castFan reports it
+  if (not_finite != 0.0) return false;  // castFan reports it
   scratch.nextScan(wall_face_count_);
 
   // ---- every face in range, seen from its free side, once
   const BeamFan fan(first_angle, increment, n);
-  const WallScan scan{ px, py, t_max * t_max * (1.0 + 1e-9), fan, scratch.inv_x.data(),
-                       scratch.inv_y.data(), scratch.best.data() };
+  const WallScan scan{
+      px, py, t_max * t_max * (1.0 + 1e-9), fan, scratch.inv_x.data(), scratch.inv_y.data(), scratch.best.data()};
   for (int ty = ty0; ty <= ty1; ++ty)
     for (int tx = tx0; tx <= tx1; ++tx)
     {
-      if (squaredDistanceToTile(tx, ty, px, py) > scan.t_max2)
-        continue;
+      if (squaredDistanceToTile(tx, ty, px, py) > scan.t_max2) continue;
       const size_t tile = (static_cast<size_t>(ty) * tiles_x_ + tx) * 4;
       for (int side = 0; side < 4; ++side)
       {
@@ -1379,28 +1307,19 @@ bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const do
         // one: skip them all when the sensor is behind every such line.
         const bool vertical = side <= kFreePlusX;
         const int tile_lo = (vertical ? tx : ty) * kTileCells;
-        if (!facesSensor(side, tile_lo, px, py) && !facesSensor(side, tile_lo + kTileCells, px, py))
-          continue;
+        if (!facesSensor(side, tile_lo, px, py) && !facesSensor(side, tile_lo + kTileCells, px, py)) continue;
         const WallFace* f = tile_faces_.data() + tile_start_[tile + side];
         const WallFace* const end = tile_faces_.data() + tile_start_[tile + side + 1];
         for (; f != end; ++f)
         {
-          if (!facesSensor(side, f->line, px, py) || scratch.seen[f->id] == scratch.scan)
-            continue;
+          if (!facesSensor(side, f->line, px, py) || scratch.seen[f->id] == scratch.scan) continue;
           scratch.seen[f->id] = scratch.scan;
           switch (side)  // (one copy of sweepFace per side, each with its constants)
           {
-            case kFreeMinusX:
-              sweepFace<kFreeMinusX>(scan, *f);
-              break;
-            case kFreePlusX:
-              sweepFace<kFreePlusX>(scan, *f);
-              break;
-            case kFreeMinusY:
-              sweepFace<kFreeMinusY>(scan, *f);
-              break;
-            default:
-              sweepFace<kFreePlusY>(scan, *f);
+            case kFreeMinusX: sweepFace<kFreeMinusX>(scan, *f); break;
+            case kFreePlusX: sweepFace<kFreePlusX>(scan, *f); break;
+            case kFreeMinusY: sweepFace<kFreeMinusY>(scan, *f); break;
+            default: sweepFace<kFreePlusY>(scan, *f);
           }
         }
       }
@@ -1412,22 +1331,19 @@ bool GridRaycaster::sweepWalls(double x, double y, const double* dir_x, const do
   return true;
 }
 
-void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec& spec,
-              std::vector<float>& ranges)
+void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec& spec, std::vector<float>& ranges)
 {
-  if (spec.beams < 0)
-    throw std::invalid_argument("castScan: beams must be >= 0, got " + std::to_string(spec.beams));
+  if (spec.beams < 0) throw std::invalid_argument("castScan: beams must be >= 0, got " + std::to_string(spec.beams));
   if (!(spec.range_max > 0.0))
-    throw std::invalid_argument("castScan: range_max must be > 0 [m], got " +
-                                std::to_string(spec.range_max));
-  if (!std::isfinite(spec.x) || !std::isfinite(spec.y) || !std::isfinite(spec.yaw) ||
-      !std::isfinite(spec.min_angle) || !std::isfinite(spec.angle_increment))
-    throw std::invalid_argument("castScan: x, y, yaw, min_angle and angle_increment must be "
-                                "finite");
+    throw std::invalid_argument("castScan: range_max must be > 0 [m], got " + std::to_string(spec.range_max));
+  if (!std::isfinite(spec.x) || !std::isfinite(spec.y) || !std::isfinite(spec.yaw) || !std::isfinite(spec.min_angle) ||
+      !std::isfinite(spec.angle_increment))
+    throw std::invalid_argument(
+        "castScan: x, y, yaw, min_angle and angle_increment must be "
+        "finite");
   const int n = spec.beams;
   ranges.resize(n);
-  if (n == 0)
-    return;
+  if (n == 0) return;
 
   // ---- beam directions
   thread_local ScanScratch scratch;
@@ -1443,12 +1359,12 @@ void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec&
     scratch.dir_y[i] = sin_yaw * layout.rel_cos[i] + cos_yaw * layout.rel_sin[i];
   }
   const BeamFan fan(spec.yaw + spec.min_angle, spec.angle_increment, n);
-  const ScanView scan{ spec.x, spec.y, spec.range_max, fan,
-                       scratch.dir_x.data(), scratch.dir_y.data(), scratch.range.data() };
+  const ScanView scan{
+      spec.x, spec.y, spec.range_max, fan, scratch.dir_x.data(), scratch.dir_y.data(), scratch.range.data()};
 
   // ---- walls first: every beam gets its grid range (range_max when it hits nothing).
-  grid.castScanWalls(spec.x, spec.y, scan.dir_x, scan.dir_y, spec.yaw + spec.min_angle,
-                     spec.angle_increment, n, spec.range_max, scan.range);
+  grid.castScanWalls(spec.x, spec.y, scan.dir_x, scan.dir_y, spec.yaw + spec.min_angle, spec.angle_increment, n,
+                     spec.range_max, scan.range);
 
   // ---- then shapes: each one can only shorten the beams inside the angle it covers.
   // Shapes are bucketed by centre, so look at buckets up to range_max + the largest shape
@@ -1464,14 +1380,11 @@ void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec&
     for (int64_t bx = bx0; bx <= bx1; ++bx)
     {
       const ShapeSet::Bucket* bucket = shapes.findBucket(bx, by);
-      if (bucket == nullptr)
-        continue;
+      if (bucket == nullptr) continue;
       for (const Circle& c : bucket->circles)
-        if (!ignored(c.owner))
-          sweepCircle(scan, c);
+        if (!ignored(c.owner)) sweepCircle(scan, c);
       for (const ShapeSet::PreparedBox& pb : bucket->boxes)
-        if (!ignored(pb.box.owner))
-          sweepBox(scan, pb.box, pb.cos_yaw, pb.sin_yaw);
+        if (!ignored(pb.box.owner)) sweepBox(scan, pb.box, pb.cos_yaw, pb.sin_yaw);
     }
   }
 

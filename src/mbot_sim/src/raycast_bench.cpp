@@ -37,9 +37,9 @@ using mbot_sim::GridRaycaster;
 using mbot_sim::ScanSpec;
 using mbot_sim::ShapeSet;
 
-constexpr double kResolution = 0.05;  // [m]
-constexpr double kRoomSize = 20.0;    // [m]
-constexpr double kWall = 0.1;         // wall thickness [m]
+constexpr double kResolution = 0.05;   // [m]
+constexpr double kRoomSize = 20.0;     // [m]
+constexpr double kWall = 0.1;          // wall thickness [m]
 constexpr double kRobotRadius = 0.15;  // [m]
 constexpr int kBeams = 360;
 constexpr double kRangeMax = 8.0;  // [m]
@@ -54,22 +54,19 @@ struct Canvas
   std::vector<uint8_t> cells;
 
   Canvas(double width, double height)
-    : size_x(static_cast<unsigned>(std::lround(width / kResolution)))
-    , size_y(static_cast<unsigned>(std::lround(height / kResolution)))
-    , cells(static_cast<size_t>(size_x) * size_y, 0)
-  {
-  }
+      : size_x(static_cast<unsigned>(std::lround(width / kResolution))),
+        size_y(static_cast<unsigned>(std::lround(height / kResolution))),
+        cells(static_cast<size_t>(size_x) * size_y, 0)
+  {}
 
   /// Mark every cell whose centre is within half a wall thickness of segment a-b [m].
   void wall(double ax, double ay, double bx, double by)
   {
     const double half = 0.5 * kWall;
     const int x0 = std::max(0, static_cast<int>((std::min(ax, bx) - half) / kResolution) - 1);
-    const int x1 =
-        std::min<int>(size_x - 1, static_cast<int>((std::max(ax, bx) + half) / kResolution) + 1);
+    const int x1 = std::min<int>(size_x - 1, static_cast<int>((std::max(ax, bx) + half) / kResolution) + 1);
     const int y0 = std::max(0, static_cast<int>((std::min(ay, by) - half) / kResolution) - 1);
-    const int y1 =
-        std::min<int>(size_y - 1, static_cast<int>((std::max(ay, by) + half) / kResolution) + 1);
+    const int y1 = std::min<int>(size_y - 1, static_cast<int>((std::max(ay, by) + half) / kResolution) + 1);
     const double dx = bx - ax;
     const double dy = by - ay;
     const double len2 = dx * dx + dy * dy;
@@ -93,10 +90,10 @@ struct Canvas
     wall(ox + e, oy + s - e, ox + s - e, oy + s - e);
     wall(ox + e, oy + e, ox + e, oy + s - e);
     wall(ox + s - e, oy + e, ox + s - e, oy + s - e);
-    wall(ox + 0.0, oy + 10.0, ox + 8.0, oy + 10.0);   // left room, door from x = 8 to 12
-    wall(ox + 12.0, oy + 4.0, ox + 12.0, oy + 16.0);  // central partition
-    wall(ox + 14.0, oy + 5.0, ox + 20.0, oy + 5.0);   // right room
-    wall(ox + 3.0, oy + 13.5, ox + 7.0, oy + 17.5);   // a diagonal wall
+    wall(ox + 0.0, oy + 10.0, ox + 8.0, oy + 10.0);     // left room, door from x = 8 to 12
+    wall(ox + 12.0, oy + 4.0, ox + 12.0, oy + 16.0);    // central partition
+    wall(ox + 14.0, oy + 5.0, ox + 20.0, oy + 5.0);     // right room
+    wall(ox + 3.0, oy + 13.5, ox + 7.0, oy + 17.5);     // a diagonal wall
     for (double y = 13.5; y <= 14.5; y += kResolution)  // a 1 x 1 m pillar
       wall(ox + 15.5, oy + y, ox + 16.5, oy + y);
   }
@@ -121,15 +118,14 @@ struct Scenario
   std::mt19937 rng;
 
   Scenario(const Canvas& canvas, int robot_count, unsigned seed)
-    : grid(canvas.cells, canvas.size_x, canvas.size_y, kResolution, 0.0, 0.0), rng(seed)
+      : grid(canvas.cells, canvas.size_x, canvas.size_y, kResolution, 0.0, 0.0), rng(seed)
   {
     for (int i = 0; i < robot_count; ++i)
     {
       const Pose p = randomFreePose();
-      robots.push_back({ p.x, p.y, p.yaw });
+      robots.push_back({p.x, p.y, p.yaw});
     }
-    for (int i = 0; i < 4096; ++i)
-      poses.push_back(randomFreePose());
+    for (int i = 0; i < 4096; ++i) poses.push_back(randomFreePose());
   }
 
   Pose randomFreePose()
@@ -139,9 +135,8 @@ struct Scenario
     std::uniform_real_distribution<double> uyaw(-M_PI, M_PI);
     for (;;)
     {
-      const Pose p{ ux(rng), uy(rng), uyaw(rng) };
-      if (grid.clearanceAt(p.x, p.y) > 2.0 * kRobotRadius)
-        return p;
+      const Pose p{ux(rng), uy(rng), uyaw(rng)};
+      if (grid.clearanceAt(p.x, p.y) > 2.0 * kRobotRadius) return p;
     }
   }
 
@@ -149,8 +144,7 @@ struct Scenario
   bool insideRobot(double x, double y) const
   {
     for (const Robot& r : robots)
-      if (std::hypot(r.x - x, r.y - y) <= kRobotRadius)
-        return true;
+      if (std::hypot(r.x - x, r.y - y) <= kRobotRadius) return true;
     return false;
   }
 
@@ -217,8 +211,7 @@ Result run(Scenario& sc, int scans_per_frame, double min_seconds, long exact_sca
     while (static_cast<int>(frame_poses.size()) < scans_per_frame)
     {
       const Pose& p = sc.poses[next_pose++ % sc.poses.size()];
-      if (!sc.insideRobot(p.x, p.y))
-        frame_poses.push_back(&p);
+      if (!sc.insideRobot(p.x, p.y)) frame_poses.push_back(&p);
     }
 
     const auto start = Clock::now();
@@ -243,8 +236,7 @@ Result run(Scenario& sc, int scans_per_frame, double min_seconds, long exact_sca
       spec.yaw = p->yaw;
       mbot_sim::castScan(sc.grid, shapes, spec, ranges);
       rays += kBeams;
-      for (float r : ranges)
-        finite += std::isfinite(r) ? 1 : 0;
+      for (float r : ranges) finite += std::isfinite(r) ? 1 : 0;
     }
     const auto end = Clock::now();
     rebuild_s += std::chrono::duration<double>(rebuilt - start).count();
@@ -285,9 +277,10 @@ int main(int argc, char** argv)
   if (exact_scans > 0)
   {
     const Result r = run(small, 10, 0.0, exact_scans);
-    std::printf("{\"rays\": %ld, \"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
-                "\"returns_fraction\": %.3f}\n",
-                r.scans * kBeams, r.rays_per_second, r.cpu_rays_per_second, r.returns_fraction);
+    std::printf(
+        "{\"rays\": %ld, \"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
+        "\"returns_fraction\": %.3f}\n",
+        r.scans * kBeams, r.rays_per_second, r.cpu_rays_per_second, r.returns_fraction);
     return 0;
   }
   run(small, 10, 0.2);  // warm up caches and the CPU clock
@@ -296,24 +289,24 @@ int main(int argc, char** argv)
   // The room tiled 3 x 3 (60 x 60 m) with 1000 robots: a scan must only visit nearby buckets.
   Canvas big(3 * kRoomSize, 3 * kRoomSize);
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i)
-      big.room(i * kRoomSize, j * kRoomSize);
+    for (int i = 0; i < 3; ++i) big.room(i * kRoomSize, j * kRoomSize);
   Scenario large(big, 1000, 2);
   const Result b = run(large, 100, seconds);
 
   // One JSON line (scripts/bench reads the last line starting with '{').
-  std::printf("{\"rays_per_second\": %.0f, \"beams\": %d, \"range_max\": %.1f, ",
-              a.rays_per_second, kBeams, kRangeMax);
-  std::printf("\"cpu_rays_per_second\": %.0f, \"ns_per_ray\": %.2f, \"scans\": %ld, "
-              "\"seconds\": %.3f, ",
-              a.cpu_rays_per_second, 1e9 / a.rays_per_second, a.scans, a.seconds);
-  std::printf("\"map\": \"room 20x20 m, 0.05 m cells\", \"robots\": 10, "
-              "\"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f, ",
-              a.returns_fraction, a.rebuild_us);
-  std::printf("\"large_map\": {\"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
-              "\"scans\": %ld, \"seconds\": %.3f, \"map\": \"room tiled 3x3, 60x60 m\", "
-              "\"robots\": 1000, \"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f}}\n",
-              b.rays_per_second, b.cpu_rays_per_second, b.scans, b.seconds, b.returns_fraction,
-              b.rebuild_us);
+  std::printf("{\"rays_per_second\": %.0f, \"beams\": %d, \"range_max\": %.1f, ", a.rays_per_second, kBeams, kRangeMax);
+  std::printf(
+      "\"cpu_rays_per_second\": %.0f, \"ns_per_ray\": %.2f, \"scans\": %ld, "
+      "\"seconds\": %.3f, ",
+      a.cpu_rays_per_second, 1e9 / a.rays_per_second, a.scans, a.seconds);
+  std::printf(
+      "\"map\": \"room 20x20 m, 0.05 m cells\", \"robots\": 10, "
+      "\"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f, ",
+      a.returns_fraction, a.rebuild_us);
+  std::printf(
+      "\"large_map\": {\"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
+      "\"scans\": %ld, \"seconds\": %.3f, \"map\": \"room tiled 3x3, 60x60 m\", "
+      "\"robots\": 1000, \"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f}}\n",
+      b.rays_per_second, b.cpu_rays_per_second, b.scans, b.seconds, b.returns_fraction, b.rebuild_us);
   return 0;
 }

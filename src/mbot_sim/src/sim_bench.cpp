@@ -40,7 +40,7 @@ struct Options
 {
   int robots = 10;
   std::string map = std::string(MBOT_MAPS_DIR) + "/bench_room.yaml";
-  double seconds = 20.0;      ///< [s sim time]
+  double seconds = 20.0;  ///< [s sim time]
   unsigned seed = 1;
   std::string model = "mbot";
   std::string description = MBOT_DESCRIPTION_DIR;
@@ -118,7 +118,7 @@ class Wanderer : public mbot_sim::SensorListener
 {
 public:
   Wanderer(mbot_sim::World& world, const mbot_description::RobotModel& model, double speed)
-    : world_(world), range_max_(model.laser.range_max), speed_(speed)
+      : world_(world), range_max_(model.laser.range_max), speed_(speed)
   {
     // Which beams look ahead, left and right: fixed by the model, so classified once.
     const double inc = model.laser.angleIncrement();
@@ -158,10 +158,10 @@ public:
 
 private:
   mbot_sim::World& world_;
-  double range_max_;  ///< [m]
-  double speed_;      ///< [m/s]
+  double range_max_;                       ///< [m]
+  double speed_;                           ///< [m/s]
   std::vector<int> ahead_, left_, right_;  ///< beam indices of the three sectors
-  std::vector<double> turn_;  ///< [rad/s] the turn a robot is in, 0 when driving
+  std::vector<double> turn_;               ///< [rad/s] the turn a robot is in, 0 when driving
 };
 
 double cpuSeconds()

@@ -115,7 +115,8 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   {
     config = loadWorldConfig(path);
     if (params.has_seed) config.seed = static_cast<unsigned>(params.seed);
-    world_ = buildWorld(config, [this](const std::string& name) { return model(name); }, params.watchdog_timeout);
+    world_ = buildWorld(
+        config, [this](const std::string& name) { return model(name); }, params.watchdog_timeout);
   }
   catch (const WorldConfigError& e)
   {
@@ -144,28 +145,28 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   if (params_.lockstep)  // only then: every /tf message costs this node a callback
   {
     tf_sub_ = nh_.subscribe("/tf", 1000, &StageRos::onTf, this, ros::TransportHints().tcpNoDelay());
-    heartbeat_sub_ = nh_.subscribe("/lockstep/heartbeat", 100, &StageRos::onHeartbeat, this,
-                                   ros::TransportHints().tcpNoDelay());
+    heartbeat_sub_ =
+        nh_.subscribe("/lockstep/heartbeat", 100, &StageRos::onHeartbeat, this, ros::TransportHints().tcpNoDelay());
   }
 
-  ROS_INFO("stage_node: world %s: %zu robots, %zu obstacles, map walls as %zu boxes, physics step %.3f s, "
-           "real-time factor %g%s, seed %u",
-           path.c_str(), world_->robotCount(), world_->obstacles().size(), world_->wallBoxCount(),
-           world_->physicsStep(), real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "",
-           config.seed);
+  ROS_INFO(
+      "stage_node: world %s: %zu robots, %zu obstacles, map walls as %zu boxes, physics step %.3f s, "
+      "real-time factor %g%s, seed %u",
+      path.c_str(), world_->robotCount(), world_->obstacles().size(), world_->wallBoxCount(), world_->physicsStep(),
+      real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "", config.seed);
   if (params_.lockstep)
-    ROS_INFO("stage_node: lockstep: sim time waits for the driven robots' cmd_vel and localization every %g s "
-             "sim time (driven: a cmd_vel within %g s sim time; localization lag up to %g s sim time; at most %g s "
-             "wall per wait)",
-             params_.lockstep_period, params_.lockstep_active_timeout, params_.lockstep_localization_lag,
-             params_.lockstep_wall_timeout);
+    ROS_INFO(
+        "stage_node: lockstep: sim time waits for the driven robots' cmd_vel and localization every %g s "
+        "sim time (driven: a cmd_vel within %g s sim time; localization lag up to %g s sim time; at most %g s "
+        "wall per wait)",
+        params_.lockstep_period, params_.lockstep_active_timeout, params_.lockstep_localization_lag,
+        params_.lockstep_wall_timeout);
 }
 
 const mbot_description::RobotModel& StageRos::model(const std::string& name)
 {
   auto it = models_.find(name);
-  if (it == models_.end())
-    it = models_.emplace(name, mbot_description::loadRobotModel(description_dir_, name)).first;
+  if (it == models_.end()) it = models_.emplace(name, mbot_description::loadRobotModel(description_dir_, name)).first;
   return it->second;
 }
 
@@ -343,9 +344,7 @@ bool StageRos::waitForControllers()
   const auto driven = [this](const RobotIo& io) {
     return world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout;
   };
-  const auto answered = [this](const RobotIo& io) {
-    return io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1;
-  };
+  const auto answered = [this](const RobotIo& io) { return io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1; };
   const auto localized = [this](const RobotIo& io) {
     return io.localization_ignored || io.localization_stamp < -1e8 ||  // none seen: nothing to wait for
            localizationCurrent(io);
@@ -392,9 +391,10 @@ bool StageRos::waitForControllers()
       const ros::WallTime wall_now = ros::WallTime::now();
       if ((wall_now - last_lockstep_warning_).toSec() >= 5.0)  // throttled: a slow controller times out often
       {
-        ROS_WARN("stage_node: lockstep: waited for %s for %g s wall at sim time %.3f s: going on "
-                 "(%ld such timeouts since the last warning)",
-                 late.c_str(), params_.lockstep_wall_timeout, world_->time(), lockstep_timeouts_);
+        ROS_WARN(
+            "stage_node: lockstep: waited for %s for %g s wall at sim time %.3f s: going on "
+            "(%ld such timeouts since the last warning)",
+            late.c_str(), params_.lockstep_wall_timeout, world_->time(), lockstep_timeouts_);
         last_lockstep_warning_ = wall_now;
         lockstep_timeouts_ = 0;
       }

@@ -42,9 +42,9 @@ namespace
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Every body is an upright 1 m tall prism centred 0.5 m above the ground, so contact normals
 // between bodies are horizontal.
-constexpr double kBodyZ = 0.5;       // [m]
-constexpr double kBodyHeight = 1.0;  // [m]
-constexpr int kMaxContacts = 4;      // contact points per pair of geoms
+constexpr double kBodyZ = 0.5;         // [m]
+constexpr double kBodyHeight = 1.0;    // [m]
+constexpr int kMaxContacts = 4;        // contact points per pair of geoms
 constexpr double kTimeEpsilon = 1e-9;  // [s] sensor timers: "due" despite rounding
 
 // Collision categories: robots collide with everything, walls and moving obstacles only with
@@ -95,10 +95,7 @@ using JointGroupPtr = std::unique_ptr<dxJointGroup, JointGroupDeleter>;
 double clamp(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }
 
 /// Move `v` towards `target` by at most `max_change`.
-double approach(double v, double target, double max_change)
-{
-  return v + clamp(target - v, -max_change, max_change);
-}
+double approach(double v, double target, double max_change) { return v + clamp(target - v, -max_change, max_change); }
 
 std::string formatPoint(double x, double y)
 {
@@ -141,22 +138,18 @@ struct BodyTag
     ROBOT
   };
   Kind kind = Kind::WALL;
-  uint32_t uid = 0;        ///< unique per body while the world lives; keys contact pairs
-  std::string name;        ///< robot or obstacle name, "map" for the walls
-  int robot = -1;          ///< robot id for robots
+  uint32_t uid = 0;  ///< unique per body while the world lives; keys contact pairs
+  std::string name;  ///< robot or obstacle name, "map" for the walls
+  int robot = -1;    ///< robot id for robots
 
   std::string describe() const
   {
     switch (kind)
     {
-      case Kind::WALL:
-        return "a wall";
-      case Kind::OBSTACLE:
-        return "obstacle " + name;
-      case Kind::MOVING:
-        return "moving obstacle " + name;
-      case Kind::ROBOT:
-        return "robot " + name;
+      case Kind::WALL: return "a wall";
+      case Kind::OBSTACLE: return "obstacle " + name;
+      case Kind::MOVING: return "moving obstacle " + name;
+      case Kind::ROBOT: return "robot " + name;
     }
     return name;
   }
@@ -172,7 +165,7 @@ struct Outline
   double half_width = 0.0;   ///< box, along its y [m]
   double offset_x = 0.0;     ///< centre in the body frame [m]
   double offset_y = 0.0;
-  double offset_yaw = 0.0;   ///< box orientation in the body frame [rad]
+  double offset_yaw = 0.0;  ///< box orientation in the body frame [rad]
 };
 
 Outline outlineOf(const ShapeConfig& shape)
@@ -271,9 +264,9 @@ struct Robot
   GeomPtr geom;
 
   // drive
-  Twist2D command;                  ///< last command, clamped to the limits
-  double command_time = -kInf;      ///< [s] when it came
-  Twist2D setpoint;                 ///< what the motors drive now (acceleration-limited)
+  Twist2D command;              ///< last command, clamped to the limits
+  double command_time = -kInf;  ///< [s] when it came
+  Twist2D setpoint;             ///< what the motors drive now (acceleration-limited)
 
   // true state after the last step
   Pose2D pose;
@@ -323,18 +316,18 @@ struct Mover
   Outline outline;
   BodyPtr body;
   GeomPtr geom;
-  std::vector<Point2D> route;     ///< closed: route.back() == route.front()
-  std::vector<double> cumulative; ///< path length at each route point [m]
-  double start_time = 0.0;        ///< [s] when it left the first waypoint
-  size_t segment = 0;             ///< cached: the route segment it is on
+  std::vector<Point2D> route;      ///< closed: route.back() == route.front()
+  std::vector<double> cumulative;  ///< path length at each route point [m]
+  double start_time = 0.0;         ///< [s] when it left the first waypoint
+  size_t segment = 0;              ///< cached: the route segment it is on
   Pose2D pose;
-  double vx = 0.0, vy = 0.0;      ///< [m/s] map frame
+  double vx = 0.0, vy = 0.0;  ///< [m/s] map frame
   // walker only
-  size_t next = 1;                ///< the route point it walks to
-  double reach = 0.0;             ///< [m] radius of the circle around its outline
-  GeomPtr probe;                  ///< its outline in no space, to test a next position against walls
-  double side = 1.0;              ///< +1: passes bodies on its right, -1: on its left
-  double stuck_time = 0.0;        ///< [s] how long it has made no headway
+  size_t next = 1;          ///< the route point it walks to
+  double reach = 0.0;       ///< [m] radius of the circle around its outline
+  GeomPtr probe;            ///< its outline in no space, to test a next position against walls
+  double side = 1.0;        ///< +1: passes bodies on its right, -1: on its left
+  double stuck_time = 0.0;  ///< [s] how long it has made no headway
 
   bool walker() const { return config.yielding > 0.0; }
 
@@ -368,8 +361,9 @@ struct World::Impl
   WorldSettings settings;
   OccupancyMap map_info;  ///< size and origin only (data cleared)
   WorldPtr world;
-  SpacePtr static_space;   ///< walls + static obstacles (quadtree: robots query it)
-  SpacePtr dynamic_space;  ///< robots + moving obstacles (sweep and prune: ~10% faster than a hash space at 1000 robots)
+  SpacePtr static_space;  ///< walls + static obstacles (quadtree: robots query it)
+  SpacePtr
+      dynamic_space;  ///< robots + moving obstacles (sweep and prune: ~10% faster than a hash space at 1000 robots)
   JointGroupPtr contact_group;
   GridRaycaster grid;
   ShapeSet shapes;
@@ -541,8 +535,7 @@ struct World::Impl
     q.query_margin = settings.contact_margin;
     q.robot_margin = settings.contact_margin;
     dSpaceCollide2(geom.get(), reinterpret_cast<dGeomID>(static_space.get()), &q, &overlapCallback);
-    if (!q.found)
-      dSpaceCollide2(geom.get(), reinterpret_cast<dGeomID>(dynamic_space.get()), &q, &overlapCallback);
+    if (!q.found) dSpaceCollide2(geom.get(), reinterpret_cast<dGeomID>(dynamic_space.get()), &q, &overlapCallback);
     return q.found;
   }
 
@@ -605,7 +598,8 @@ struct World::Impl
     if (model.drive == DriveType::DIFF)
       robot->wheel_mounts = {{0.0, half_sep}, {0.0, -half_sep}};
     else
-      robot->wheel_mounts = {{half_base, half_sep}, {half_base, -half_sep}, {-half_base, half_sep}, {-half_base, -half_sep}};
+      robot->wheel_mounts = {
+          {half_base, half_sep}, {half_base, -half_sep}, {-half_base, half_sep}, {-half_base, -half_sep}};
     robot->wheel_mounts.resize(model.wheel_joints.size());
     robot->joints.position.assign(robot->wheel_mounts.size(), 0.0);
     robot->joints.velocity.assign(robot->wheel_mounts.size(), 0.0);
@@ -693,7 +687,8 @@ struct World::Impl
   /// from `obstacles` at every scan. So destroying the geom (it leaves its space) is enough.
   void removeObstacle(const std::string& name)
   {
-    const auto it = std::find_if(obstacles.begin(), obstacles.end(), [&](const auto& o) { return o->tag.name == name; });
+    const auto it =
+        std::find_if(obstacles.begin(), obstacles.end(), [&](const auto& o) { return o->tag.name == name; });
     if (it != obstacles.end())
     {
       names.erase(name);
@@ -711,7 +706,8 @@ struct World::Impl
   void addMovingObstacle(const MovingObstacleConfig& config)
   {
     claimName(config.name, "moving obstacle");
-    if (config.waypoints.size() < 2) throw SimError("moving obstacle " + config.name + ": expected at least 2 waypoints");
+    if (config.waypoints.size() < 2)
+      throw SimError("moving obstacle " + config.name + ": expected at least 2 waypoints");
     if (!(config.speed > 0.0)) throw SimError("moving obstacle " + config.name + ": expected a speed > 0");
     if (!(config.yielding >= 0.0 && config.yielding <= 1.0))
       throw SimError("moving obstacle " + config.name + ": expected a yielding in [0, 1]");
@@ -781,8 +777,7 @@ struct World::Impl
     Robot& r = needRobot(name);
     if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
       throw SimError("robot " + name + ": the pose is not finite");
-    if (!insideMap(pose.x, pose.y))
-      throw SimError("pose " + formatPoint(pose.x, pose.y) + " is outside the map");
+    if (!insideMap(pose.x, pose.y)) throw SimError("pose " + formatPoint(pose.x, pose.y) + " is outside the map");
     if (const BodyTag* other = overlapping(r.outline, pose, &r.tag, true))
       throw SimError("robot " + name + " at " + formatPoint(pose.x, pose.y) + " would overlap " + other->describe());
     placeBody(r, pose);
@@ -916,8 +911,8 @@ struct World::Impl
       const double gap = d - m.reach - b.radius;
       if (gap >= c.personal_radius) continue;
       const double s = std::min(1.0, (c.personal_radius - gap) / c.personal_radius);  // 0 at the edge
-      const double ahead = -(nx * ex + ny * ey);  // 1: straight ahead, -1: behind
-      const double weight = 0.5 + 0.5 * std::max(0.0, ahead);  // what is ahead matters more
+      const double ahead = -(nx * ex + ny * ey);                                      // 1: straight ahead, -1: behind
+      const double weight = 0.5 + 0.5 * std::max(0.0, ahead);                         // what is ahead matters more
       fx += 2.0 * s * s * weight * nx;
       fy += 2.0 * s * s * weight * ny;
       if (ahead > 0.0)
@@ -1008,7 +1003,8 @@ struct World::Impl
     const auto* ta = static_cast<const BodyTag*>(dGeomGetData(a));
     const auto* tb = static_cast<const BodyTag*>(dGeomGetData(b));
     if (ta->uid > tb->uid) std::swap(ta, tb);
-    hits.push_back(Hit{(static_cast<uint64_t>(ta->uid) << 32) | tb->uid, ta, tb, contacts[0].pos[0], contacts[0].pos[1]});
+    hits.push_back(
+        Hit{(static_cast<uint64_t>(ta->uid) << 32) | tb->uid, ta, tb, contacts[0].pos[0], contacts[0].pos[1]});
   }
 
   void driveRobot(Robot& r, double dt)
@@ -1288,8 +1284,7 @@ struct World::Impl
   }
 
   template <class Sample>
-  void releasePending(Robot& r, std::deque<Pending<Sample>>& queue,
-                      void (SensorListener::*deliver)(int, const Sample&))
+  void releasePending(Robot& r, std::deque<Pending<Sample>>& queue, void (SensorListener::*deliver)(int, const Sample&))
   {
     while (!queue.empty() && queue.front().release <= time() + kTimeEpsilon)
     {

@@ -29,38 +29,33 @@ struct Cell
   int x, y;
 };
 
-GridRaycaster makeGrid(unsigned w, unsigned h, double res, double ox, double oy,
-                       const std::vector<Cell>& occupied)
+GridRaycaster makeGrid(unsigned w, unsigned h, double res, double ox, double oy, const std::vector<Cell>& occupied)
 {
   std::vector<uint8_t> cells(static_cast<size_t>(w) * h, 0);
-  for (const Cell& c : occupied)
-    cells[static_cast<size_t>(c.y) * w + c.x] = 1;
+  for (const Cell& c : occupied) cells[static_cast<size_t>(c.y) * w + c.x] = 1;
   return GridRaycaster(cells, w, h, res, ox, oy);
 }
 
 /// Reference: ray (x, y) + t (cos a, sin a) against the axis-aligned square [x0, x1] x [y0, y1]
 /// by the slab method: entry distance (0 when starting inside), or +Inf on a miss.
-double raySquare(double x, double y, double ux, double uy, double x0, double y0, double x1,
-                 double y1)
+double raySquare(double x, double y, double ux, double uy, double x0, double y0, double x1, double y1)
 {
   double t_in = 0.0;
   double t_out = kInf;
-  const double p[2] = { x, y };
-  const double u[2] = { ux, uy };
-  const double lo[2] = { x0, y0 };
-  const double hi[2] = { x1, y1 };
+  const double p[2] = {x, y};
+  const double u[2] = {ux, uy};
+  const double lo[2] = {x0, y0};
+  const double hi[2] = {x1, y1};
   for (int a = 0; a < 2; ++a)
   {
     if (u[a] == 0.0)
     {
-      if (p[a] < lo[a] || p[a] > hi[a])
-        return kInf;
+      if (p[a] < lo[a] || p[a] > hi[a]) return kInf;
       continue;
     }
     double t0 = (lo[a] - p[a]) / u[a];
     double t1 = (hi[a] - p[a]) / u[a];
-    if (t0 > t1)
-      std::swap(t0, t1);
+    if (t0 > t1) std::swap(t0, t1);
     t_in = std::max(t_in, t0);
     t_out = std::min(t_out, t1);
   }
@@ -68,8 +63,8 @@ double raySquare(double x, double y, double ux, double uy, double x0, double y0,
 }
 
 /// Reference: test the ray against every occupied cell of a grid, return the nearest entry.
-double bruteForceGridCast(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res,
-                          double ox, double oy, double x, double y, double theta, double max_range)
+double bruteForceGridCast(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res, double ox, double oy,
+                          double x, double y, double theta, double max_range)
 {
   const double ux = std::cos(theta);
   const double uy = std::sin(theta);
@@ -78,8 +73,7 @@ double bruteForceGridCast(const std::vector<uint8_t>& cells, unsigned w, unsigne
     for (unsigned i = 0; i < w; ++i)
       if (cells[static_cast<size_t>(j) * w + i])
       {
-        const double t = raySquare(x, y, ux, uy, ox + i * res, oy + j * res, ox + (i + 1) * res,
-                                   oy + (j + 1) * res);
+        const double t = raySquare(x, y, ux, uy, ox + i * res, oy + j * res, ox + (i + 1) * res, oy + (j + 1) * res);
         best = std::min(best, t);
       }
   return best;
@@ -98,12 +92,10 @@ double rayPolygon(double x, double y, double ux, double uy, const std::vector<do
     const double ex = px[(k + 1) % n] - ax, ey = py[(k + 1) % n] - ay;
     // Solve (x, y) + t u = a + s e.
     const double den = ux * ey - uy * ex;
-    if (std::abs(den) < 1e-15)
-      continue;
+    if (std::abs(den) < 1e-15) continue;
     const double t = ((ax - x) * ey - (ay - y) * ex) / den;
     const double s = ((ax - x) * uy - (ay - y) * ux) / den;
-    if (t >= 0.0 && s >= 0.0 && s <= 1.0)
-      best = std::min(best, t);
+    if (t >= 0.0 && s >= 0.0 && s <= 1.0) best = std::min(best, t);
   }
   return best;
 }
@@ -111,22 +103,20 @@ double rayPolygon(double x, double y, double ux, double uy, const std::vector<do
 std::vector<double> boxCornersX(const OrientedBox& b)
 {
   const double c = std::cos(b.yaw), s = std::sin(b.yaw);
-  const double lx[4] = { b.half_length, -b.half_length, -b.half_length, b.half_length };
-  const double ly[4] = { b.half_width, b.half_width, -b.half_width, -b.half_width };
+  const double lx[4] = {b.half_length, -b.half_length, -b.half_length, b.half_length};
+  const double ly[4] = {b.half_width, b.half_width, -b.half_width, -b.half_width};
   std::vector<double> out;
-  for (int k = 0; k < 4; ++k)
-    out.push_back(b.x + c * lx[k] - s * ly[k]);
+  for (int k = 0; k < 4; ++k) out.push_back(b.x + c * lx[k] - s * ly[k]);
   return out;
 }
 
 std::vector<double> boxCornersY(const OrientedBox& b)
 {
   const double c = std::cos(b.yaw), s = std::sin(b.yaw);
-  const double lx[4] = { b.half_length, -b.half_length, -b.half_length, b.half_length };
-  const double ly[4] = { b.half_width, b.half_width, -b.half_width, -b.half_width };
+  const double lx[4] = {b.half_length, -b.half_length, -b.half_length, b.half_length};
+  const double ly[4] = {b.half_width, b.half_width, -b.half_width, -b.half_width};
   std::vector<double> out;
-  for (int k = 0; k < 4; ++k)
-    out.push_back(b.y + s * lx[k] + c * ly[k]);
+  for (int k = 0; k < 4; ++k) out.push_back(b.y + s * lx[k] + c * ly[k]);
   return out;
 }
 
@@ -137,8 +127,7 @@ double rayCircleRef(double x, double y, double ux, double uy, const Circle& c)
   const double b = fx * ux + fy * uy;
   const double cc = fx * fx + fy * fy - c.radius * c.radius;
   const double disc = b * b - cc;
-  if (disc < 0.0)
-    return kInf;
+  if (disc < 0.0) return kInf;
   const double t = -b - std::sqrt(disc);
   return t >= 0.0 ? t : kInf;
 }
@@ -156,10 +145,7 @@ ScanSpec oneBeam(double x, double y, double yaw, double range_max)
 }
 
 /// An empty 10 x 10 m grid around the origin, for shape-only tests.
-GridRaycaster emptyGrid()
-{
-  return makeGrid(200, 200, 0.05, -5.0, -5.0, {});
-}
+GridRaycaster emptyGrid() { return makeGrid(200, 200, 0.05, -5.0, -5.0, {}); }
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -174,10 +160,10 @@ TEST(GridRaycaster, WallTwoMetresAwayReadsTwoMinusHalfACell)
   std::vector<Cell> walls;
   for (int k = 0; k < 121; ++k)
   {
-    walls.push_back({ 100, k });
-    walls.push_back({ 20, k });
-    walls.push_back({ k, 100 });
-    walls.push_back({ k, 20 });
+    walls.push_back({100, k});
+    walls.push_back({20, k});
+    walls.push_back({k, 100});
+    walls.push_back({k, 20});
   }
   const GridRaycaster grid = makeGrid(121, 121, res, ox, oy, walls);
   const double x = ox + 60.5 * res, y = oy + 60.5 * res;
@@ -196,7 +182,7 @@ TEST(GridRaycaster, SingleCellAlongDiagonalsHitsTheCorner)
 {
   // One occupied cell (20, 20); the sensor at cell centres on the four diagonals.
   const double res = 0.1;
-  const GridRaycaster grid = makeGrid(41, 41, res, 0.0, 0.0, { { 20, 20 } });
+  const GridRaycaster grid = makeGrid(41, 41, res, 0.0, 0.0, {{20, 20}});
   // From (10.5, 10.5) cells towards +x+y: enters the cell through its corner (20, 20).
   const double d = 9.5 * std::sqrt(2.0) * res;
   EXPECT_NEAR(grid.cast(10.5 * res, 10.5 * res, M_PI / 4, 8.0), d, 1e-9);
@@ -210,7 +196,7 @@ TEST(GridRaycaster, SingleCellAtOddAnglesMatchesAnalyticSquare)
 {
   const double res = 0.05;
   const int cx = 37, cy = 23;
-  const GridRaycaster grid = makeGrid(80, 60, res, 0.0, 0.0, { { cx, cy } });
+  const GridRaycaster grid = makeGrid(80, 60, res, 0.0, 0.0, {{cx, cy}});
   const double x0 = cx * res, y0 = cy * res, x1 = x0 + res, y1 = y0 + res;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> ux(0.0, 80 * res), uy(0.0, 60 * res);
@@ -222,8 +208,7 @@ TEST(GridRaycaster, SingleCellAtOddAnglesMatchesAnalyticSquare)
     // Aim at a random point of the cell, so that most rays hit it at odd angles.
     const double tx = x0 + in_cell(rng) * res, ty = y0 + in_cell(rng) * res;
     const double theta = std::atan2(ty - y, tx - x);
-    const double expected = std::min(
-        8.0, raySquare(x, y, std::cos(theta), std::sin(theta), x0, y0, x1, y1));
+    const double expected = std::min(8.0, raySquare(x, y, std::cos(theta), std::sin(theta), x0, y0, x1, y1));
     const double got = grid.cast(x, y, theta, 8.0);
     ASSERT_NEAR(got, expected, 1e-9) << "ray from (" << x << ", " << y << ") at " << theta;
     hits += expected < 8.0 ? 1 : 0;
@@ -236,8 +221,7 @@ TEST(GridRaycaster, OriginOutsideTheGridAndRaysLeavingIt)
   const double res = 0.05;
   // A 5 x 5 m grid at the origin with one wall column at x = 4 m (cells 80).
   std::vector<Cell> walls;
-  for (int k = 0; k < 100; ++k)
-    walls.push_back({ 80, k });
+  for (int k = 0; k < 100; ++k) walls.push_back({80, k});
   const GridRaycaster grid = makeGrid(100, 100, res, 0.0, 0.0, walls);
   // Outside, looking away: max range.
   EXPECT_EQ(grid.cast(-1.0, 2.0, M_PI, 8.0), 8.0);
@@ -262,7 +246,7 @@ TEST(GridRaycaster, ClearanceIsTheSquareToSquareDistance)
   // occupied square (that is what makes the long steps safe), and is stored rounded down to a
   // quarter cell, so it is at most a quarter cell less.
   const double res = 0.1;
-  const std::vector<Cell> occ = { { 5, 5 }, { 6, 5 }, { 20, 14 }, { 3, 17 } };
+  const std::vector<Cell> occ = {{5, 5}, {6, 5}, {20, 14}, {3, 17}};
   const GridRaycaster grid = makeGrid(30, 20, res, 0.0, 0.0, occ);
   for (int j = 0; j < 20; ++j)
     for (int i = 0; i < 30; ++i)
@@ -293,12 +277,11 @@ TEST(GridRaycaster, QuadrantClearanceIgnoresOnlyWallsBehind)
   std::vector<Cell> occ;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i)
-      if (sparse(rng))
-        occ.push_back({ i, j });
+      if (sparse(rng)) occ.push_back({i, j});
   const GridRaycaster grid = makeGrid(w, h, res, 0.0, 0.0, occ);
   auto gap = [](int d) { return std::max(std::abs(d) - 1.0, 0.0); };
   int longer = 0;
-  for (int sign : { 1, -1 })
+  for (int sign : {1, -1})
     for (int j = 0; j < h; ++j)
       for (int i = 0; i < w; ++i)
       {
@@ -310,12 +293,9 @@ TEST(GridRaycaster, QuadrantClearanceIgnoresOnlyWallsBehind)
           const double d = std::hypot(gap(c.x - i), gap(c.y - j));
           const bool ax = sign * (c.x - i) >= 0, ay = sign * (c.y - j) >= 0;
           any = std::min(any, d);
-          if (ax)
-            ahead_x = std::min(ahead_x, d);
-          if (ay)
-            ahead_y = std::min(ahead_y, d);
-          if (ax && ay)
-            ahead_both = std::min(ahead_both, d);
+          if (ax) ahead_x = std::min(ahead_x, d);
+          if (ay) ahead_y = std::min(ahead_y, d);
+          if (ax && ay) ahead_both = std::min(ahead_both, d);
         }
         const double got = grid.clearanceAlong((i + 0.5) * res, (j + 0.5) * res, sign, sign) / res;
         if (wall)
@@ -342,13 +322,10 @@ TEST(GridRaycaster, RandomRaysMatchBruteForce)
   std::mt19937 rng(42);
   std::vector<uint8_t> cells(w * h, 0);
   std::bernoulli_distribution sparse(0.02);
-  for (auto& c : cells)
-    c = sparse(rng) ? 1 : 0;
-  for (int k = 10; k < 60; ++k)
-    cells[static_cast<size_t>(k) * w + k] = 1;  // diagonal staircase
+  for (auto& c : cells) c = sparse(rng) ? 1 : 0;
+  for (int k = 10; k < 60; ++k) cells[static_cast<size_t>(k) * w + k] = 1;  // diagonal staircase
   for (int y = 30; y < 38; ++y)
-    for (int x = 60; x < 75; ++x)
-      cells[static_cast<size_t>(y) * w + x] = 1;  // a block
+    for (int x = 60; x < 75; ++x) cells[static_cast<size_t>(y) * w + x] = 1;  // a block
   const GridRaycaster grid(cells, w, h, res, ox, oy);
 
   std::uniform_real_distribution<double> ux(ox - 0.5, ox + w * res + 0.5);
@@ -359,11 +336,10 @@ TEST(GridRaycaster, RandomRaysMatchBruteForce)
   for (int k = 0; k < 10000; ++k)
   {
     const double x = ux(rng), y = uy(rng), theta = ua(rng), max_range = ur(rng);
-    const double expected =
-        bruteForceGridCast(cells, w, h, res, ox, oy, x, y, theta, max_range);
+    const double expected = bruteForceGridCast(cells, w, h, res, ox, oy, x, y, theta, max_range);
     const double got = grid.cast(x, y, theta, max_range);
-    ASSERT_NEAR(got, expected, 1e-5) << "ray " << k << " from (" << x << ", " << y << ") at "
-                                     << theta << " max " << max_range;
+    ASSERT_NEAR(got, expected, 1e-5) << "ray " << k << " from (" << x << ", " << y << ") at " << theta << " max "
+                                     << max_range;
     hits += expected < max_range ? 1 : 0;
   }
   // The test is only meaningful if many rays hit something (about half do).
@@ -391,48 +367,43 @@ TEST(GridRaycaster, NearlyAxisParallelRaysAtCellBoundariesMatchBruteForce)
     cells[20 * w + k] = wall(rng);
   }
   const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
-  const double tilts[] = { 0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7, 1e-4, -1e-4 };
-  const double offsets[] = { -std::ldexp(1.0, -27), -std::ldexp(1.0, -40), 0.0,
-                             std::ldexp(1.0, -40), std::ldexp(1.0, -27) };  // [cells]
+  const double tilts[] = {0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7, 1e-4, -1e-4};
+  const double offsets[] = {-std::ldexp(1.0, -27), -std::ldexp(1.0, -40), 0.0, std::ldexp(1.0, -40),
+                            std::ldexp(1.0, -27)};  // [cells]
   int hits = 0, rays = 0;
-  for (double along : { 2.5, 13.75, 37.5 })  // [cells] where on the boundary the ray starts
+  for (double along : {2.5, 13.75, 37.5})  // [cells] where on the boundary the ray starts
     for (double off : offsets)
       for (double tilt : tilts)
-        for (double axis : { 0.0, 0.5 * M_PI, M_PI, 1.5 * M_PI })
+        for (double axis : {0.0, 0.5 * M_PI, M_PI, 1.5 * M_PI})
         {
           const bool vertical = std::abs(std::sin(axis)) > 0.5;
           // Vertical rays start on the boundary x = 20 cells; horizontal ones on y = 20.
           const double x = (vertical ? 20.0 + off : along) * res;
           const double y = (vertical ? along : 20.0 + off) * res;
-          if (grid.occupiedAt(x, y))
-            continue;
+          if (grid.occupiedAt(x, y)) continue;
           const double theta = axis + tilt;
           const double expected = bruteForceGridCast(cells, w, h, res, 0.0, 0.0, x, y, theta, 3.0);
           const double got = grid.cast(x, y, theta, 3.0);
           ++rays;
-          if (expected < 3.0)
-            ++hits;
+          if (expected < 3.0) ++hits;
           // A ray starting exactly on a boundary may touch a wall's edge at t = 0, or run along
           // it: a tie, which the reference calls a hit and the tracer may not.
-          if (off == 0.0)
-            continue;
-          ASSERT_NEAR(got, expected, 1e-5) << "from (" << x / res << ", " << y / res
-                                           << ") cells at " << theta;
+          if (off == 0.0) continue;
+          ASSERT_NEAR(got, expected, 1e-5) << "from (" << x / res << ", " << y / res << ") cells at " << theta;
         }
   EXPECT_GT(rays, 400);
   EXPECT_GT(hits, 200);
 }
 
 /// Reference for a ray given by its direction (ux, uy) rather than an angle.
-double bruteForceGridCastDir(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res,
-                             double x, double y, double ux, double uy, double max_range)
+double bruteForceGridCastDir(const std::vector<uint8_t>& cells, unsigned w, unsigned h, double res, double x, double y,
+                             double ux, double uy, double max_range)
 {
   double best = max_range;
   for (unsigned j = 0; j < h; ++j)
     for (unsigned i = 0; i < w; ++i)
       if (cells[static_cast<size_t>(j) * w + i])
-        best = std::min(best, raySquare(x, y, ux, uy, i * res, j * res, (i + 1) * res,
-                                        (j + 1) * res));
+        best = std::min(best, raySquare(x, y, ux, uy, i * res, j * res, (i + 1) * res, (j + 1) * res));
   return best;
 }
 
@@ -448,20 +419,16 @@ TEST(GridRaycaster, FanBeamGroupsMatchBruteForce)
   std::mt19937 rng(17);
   std::vector<uint8_t> cells(w * h, 0);
   std::bernoulli_distribution sparse(0.03);
-  for (auto& c : cells)
-    c = sparse(rng) ? 1 : 0;
-  for (int k = 5; k < 40; ++k)
-    cells[static_cast<size_t>(k) * w + k + 10] = 1;  // a diagonal staircase
+  for (auto& c : cells) c = sparse(rng) ? 1 : 0;
+  for (int k = 5; k < 40; ++k) cells[static_cast<size_t>(k) * w + k + 10] = 1;  // a diagonal staircase
   for (unsigned y = 20; y < 24; ++y)
-    for (unsigned x = 40; x < 65; ++x)
-      cells[y * w + x] = 1;  // a block
+    for (unsigned x = 40; x < 65; ++x) cells[y * w + x] = 1;  // a block
   const GridRaycaster grid(cells, w, h, res, 0.0, 0.0);
 
   const double d = std::sqrt(0.5);
-  const std::vector<std::pair<double, double>> special = {
-    { 1.0, 0.0 }, { 0.0, 1.0 }, { -1.0, 0.0 }, { 0.0, -1.0 }, { -0.0, 1.0 }, { 1.0, -0.0 },
-    { -1.0, -0.0 }, { -0.0, -1.0 }, { d, d }, { -d, d }, { -d, -d }, { d, -d }
-  };
+  const std::vector<std::pair<double, double>> special = {{1.0, 0.0},  {0.0, 1.0},  {-1.0, 0.0},  {0.0, -1.0},
+                                                          {-0.0, 1.0}, {1.0, -0.0}, {-1.0, -0.0}, {-0.0, -1.0},
+                                                          {d, d},      {-d, d},     {-d, -d},     {d, -d}};
   std::uniform_real_distribution<double> ux(0.0, w * res), uy(0.0, h * res);
   std::uniform_real_distribution<double> ua(-M_PI, M_PI), ur(0.02, 5.0);
   std::uniform_int_distribution<int> un(1, 23);
@@ -475,16 +442,14 @@ TEST(GridRaycaster, FanBeamGroupsMatchBruteForce)
       // within 1e-7 cells of that wall.
       unsigned cx = static_cast<unsigned>(x / res);
       const unsigned cy = static_cast<unsigned>(y / res);
-      while (cx + 1 < w && !(!cells[cy * w + cx] && cells[cy * w + cx + 1]))
-        ++cx;
+      while (cx + 1 < w && !(!cells[cy * w + cx] && cells[cy * w + cx + 1])) ++cx;
       if (cx + 1 < w)
       {
         x = (cx + 1 - 1e-7) * res;
         ++next_to_wall;
       }
     }
-    if (grid.occupiedAt(x, y))
-      continue;
+    if (grid.occupiedAt(x, y)) continue;
     const int n = un(rng);
     std::vector<double> dx(n), dy(n), got(n);
     for (int i = 0; i < n; ++i)
@@ -506,11 +471,9 @@ TEST(GridRaycaster, FanBeamGroupsMatchBruteForce)
     grid.castFan(x, y, dx.data(), dy.data(), n, max_range, got.data());
     for (int i = 0; i < n; ++i)
     {
-      const double expected =
-          bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
-      ASSERT_NEAR(got[i], expected, 1e-9) << "fan " << fan << " beam " << i << " of " << n
-                                          << " from (" << x << ", " << y << ") along ("
-                                          << dx[i] << ", " << dy[i] << ") max " << max_range;
+      const double expected = bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
+      ASSERT_NEAR(got[i], expected, 1e-9) << "fan " << fan << " beam " << i << " of " << n << " from (" << x << ", "
+                                          << y << ") along (" << dx[i] << ", " << dy[i] << ") max " << max_range;
       // The single-ray call takes the other path (no group) and must agree.
       ASSERT_NEAR(grid.castDirection(x, y, dx[i], dy[i], max_range), expected, 1e-9);
       ++rays;
@@ -527,25 +490,25 @@ TEST(GridRaycaster, FanEdgeCases)
 {
   // A 4 x 4 m room (0.1 m cells) with one-cell walls on all sides and a wall cell at (20, 10).
   const double res = 0.1;
-  std::vector<Cell> walls = { { 20, 10 } };
+  std::vector<Cell> walls = {{20, 10}};
   for (int k = 0; k < 40; ++k)
   {
-    walls.push_back({ k, 0 });
-    walls.push_back({ k, 39 });
-    walls.push_back({ 0, k });
-    walls.push_back({ 39, k });
+    walls.push_back({k, 0});
+    walls.push_back({k, 39});
+    walls.push_back({0, k});
+    walls.push_back({39, k});
   }
   const GridRaycaster grid = makeGrid(40, 40, res, 0.0, 0.0, walls);
   const double d = std::sqrt(0.5);
   // Eight beams at 0, 45, ..., 315 degrees from the centre of cell (10, 10): the diagonal ones
   // run exactly through cell corners to the corner wall cells.
-  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
-  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  const double dx[8] = {1, d, 0, -d, -1, -d, 0, d};
+  const double dy[8] = {0, d, 1, d, 0, -d, -1, -d};
   double got[8];
   grid.castFan(1.05, 1.05, dx, dy, 8, 8.0, got);
-  EXPECT_NEAR(got[0], 0.95, 1e-12);               // to the wall cell (20, 10)
-  EXPECT_NEAR(got[2], 2.85, 1e-12);               // to the top wall (y = 3.9 m)
-  EXPECT_NEAR(got[4], 0.95, 1e-12);               // to the left wall (x = 0.1 m)
+  EXPECT_NEAR(got[0], 0.95, 1e-12);  // to the wall cell (20, 10)
+  EXPECT_NEAR(got[2], 2.85, 1e-12);  // to the top wall (y = 3.9 m)
+  EXPECT_NEAR(got[4], 0.95, 1e-12);  // to the left wall (x = 0.1 m)
   EXPECT_NEAR(got[6], 0.95, 1e-12);
   EXPECT_NEAR(got[1], 2.85 * std::sqrt(2.0), 1e-9);  // corner (3.9, 3.9)
   EXPECT_NEAR(got[5], 0.95 * std::sqrt(2.0), 1e-9);  // corner (0.1, 0.1)
@@ -559,11 +522,10 @@ TEST(GridRaycaster, FanEdgeCases)
   grid.castFan(1.05, 1.05, dx, dy, 1, 0.95 + 1e-9, got);
   EXPECT_NEAR(got[0], 0.95, 1e-12);
   // Without the room's walls, beams leave the grid (through edges and corners): max range.
-  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, { { 20, 10 } });
+  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, {{20, 10}});
   open_grid.castFan(1.05, 1.05, dx, dy, 8, 8.0, got);
   EXPECT_NEAR(got[0], 0.95, 1e-12);
-  for (int i = 1; i < 8; ++i)
-    EXPECT_EQ(got[i], 8.0) << "beam " << i;
+  for (int i = 1; i < 8; ++i) EXPECT_EQ(got[i], 8.0) << "beam " << i;
   // A sensor on the grid's edge looking out along it.
   EXPECT_EQ(open_grid.castDirection(0.0, 1.0, -1.0, 0.0, 8.0), 8.0);
   EXPECT_EQ(open_grid.castDirection(0.0, 1.0, 0.0, 1.0, 8.0), 8.0);
@@ -571,12 +533,10 @@ TEST(GridRaycaster, FanEdgeCases)
 
 TEST(GridRaycaster, RejectsInconsistentInput)
 {
-  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(10, 0), 4, 4, 0.05, 0.0, 0.0),
-               std::invalid_argument);
-  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(16, 0), 4, 4, 0.0, 0.0, 0.0),
-               std::invalid_argument);
+  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(10, 0), 4, 4, 0.05, 0.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(GridRaycaster(std::vector<uint8_t>(16, 0), 4, 4, 0.0, 0.0, 0.0), std::invalid_argument);
   EXPECT_THROW(ShapeSet(0.0), std::invalid_argument);
-  const GridRaycaster grid = makeGrid(4, 4, 0.05, 0.0, 0.0, { { 1, 1 } });
+  const GridRaycaster grid = makeGrid(4, 4, 0.05, 0.0, 0.0, {{1, 1}});
   EXPECT_THROW(grid.cast(0.1, 0.1, std::nan(""), 1.0), std::invalid_argument);
   EXPECT_EQ(grid.cast(std::nan(""), 0.1, 0.0, 1.0), 1.0);  // no position: no return
 }
@@ -601,8 +561,7 @@ TEST(CastScan, CircleAtThreeMetresReadsTwoAndAHalf)
   // Off-centre beam: the analytic chord entry.
   const double a = 0.1;
   castScan(grid, shapes, oneBeam(0.0, 0.0, a, 8.0), ranges);
-  EXPECT_NEAR(ranges[0], 3.0 * std::cos(a) - std::sqrt(0.25 - std::pow(3.0 * std::sin(a), 2)),
-              1e-6);
+  EXPECT_NEAR(ranges[0], 3.0 * std::cos(a) - std::sqrt(0.25 - std::pow(3.0 * std::sin(a), 2)), 1e-6);
   // Just past the tangent (asin(0.5 / 3) = 0.1674 rad): no return.
   castScan(grid, shapes, oneBeam(0.0, 0.0, 0.17, 8.0), ranges);
   EXPECT_EQ(ranges[0], std::numeric_limits<float>::infinity());
@@ -683,16 +642,14 @@ TEST(CastScan, OwnBodyIsNotSeen)
   // is closer than range_min.
   s.ignore_owner = -1;
   castScan(grid, shapes, s, ranges);
-  for (float r : ranges)
-    EXPECT_EQ(r, -inf);
+  for (float r : ranges) EXPECT_EQ(r, -inf);
 }
 
 TEST(CastScan, Rep117InfinitiesAndWalls)
 {
   // A wall column 3 m in front of the sensor.
   std::vector<Cell> walls;
-  for (int k = 0; k < 200; ++k)
-    walls.push_back({ 160, k });  // x in [3.0, 3.05]
+  for (int k = 0; k < 200; ++k) walls.push_back({160, k});  // x in [3.0, 3.05]
   const GridRaycaster grid = makeGrid(200, 200, 0.05, -5.0, -5.0, walls);
   ShapeSet shapes;
   Circle near;
@@ -825,7 +782,7 @@ TEST(CastScan, ShapeAcrossTheScanSeamIsSeenByFirstAndLastBeams)
   std::vector<float> ranges;
   castScan(grid, shapes, s, ranges);
   // asin(0.1 / 2) = 2.87 degrees: beams within +-2.87 degrees of 180 are hit.
-  for (int i : { 0, 1, 2, 357, 358, 359 })
+  for (int i : {0, 1, 2, 357, 358, 359})
   {
     const double a = s.min_angle + i * s.angle_increment;
     EXPECT_NEAR(ranges[i], rayCircleRef(0, 0, std::cos(a), std::sin(a), c), 1e-6) << i;
@@ -845,10 +802,8 @@ TEST(CastScan, RandomScansMatchBruteForce)
   std::mt19937 rng(3);
   std::vector<uint8_t> cells(w * h, 0);
   std::bernoulli_distribution sparse(0.004);
-  for (auto& c : cells)
-    c = sparse(rng) ? 1 : 0;
-  for (unsigned x = 0; x < w; ++x)
-    cells[x] = cells[(h - 1) * w + x] = 1;
+  for (auto& c : cells) c = sparse(rng) ? 1 : 0;
+  for (unsigned x = 0; x < w; ++x) cells[x] = cells[(h - 1) * w + x] = 1;
   const GridRaycaster grid(cells, w, h, res, ox, oy);
 
   std::uniform_real_distribution<double> ux(-5.0, 5.0), uy(-4.0, 4.0), ua(-M_PI, M_PI);
@@ -897,17 +852,14 @@ TEST(CastScan, RandomScansMatchBruteForce)
     // Sensors inside a seen shape read all -Inf; checked elsewhere, skip those here.
     bool inside = false;
     for (const Circle& c : circles)
-      if (c.owner != s.ignore_owner && std::hypot(c.x - s.x, c.y - s.y) <= c.radius)
-        inside = true;
+      if (c.owner != s.ignore_owner && std::hypot(c.x - s.x, c.y - s.y) <= c.radius) inside = true;
     for (const OrientedBox& b : boxes)
     {
       const double lx = std::cos(b.yaw) * (s.x - b.x) + std::sin(b.yaw) * (s.y - b.y);
       const double ly = -std::sin(b.yaw) * (s.x - b.x) + std::cos(b.yaw) * (s.y - b.y);
-      if (std::abs(lx) <= b.half_length && std::abs(ly) <= b.half_width)
-        inside = true;
+      if (std::abs(lx) <= b.half_length && std::abs(ly) <= b.half_width) inside = true;
     }
-    if (inside || grid.occupiedAt(s.x, s.y))
-      continue;
+    if (inside || grid.occupiedAt(s.x, s.y)) continue;
     ++scans;
     castScan(grid, shapes, s, ranges);
     for (int i = 0; i < s.beams; ++i)
@@ -917,8 +869,7 @@ TEST(CastScan, RandomScansMatchBruteForce)
       double expected = bruteForceGridCast(cells, w, h, res, ox, oy, s.x, s.y, a, s.range_max);
       double shape = kInf;
       for (const Circle& c : circles)
-        if (c.owner != s.ignore_owner || s.ignore_owner < 0)
-          shape = std::min(shape, rayCircleRef(s.x, s.y, cx, cy, c));
+        if (c.owner != s.ignore_owner || s.ignore_owner < 0) shape = std::min(shape, rayCircleRef(s.x, s.y, cx, cy, c));
       for (const OrientedBox& b : boxes)
         if (b.owner != s.ignore_owner || s.ignore_owner < 0)
           shape = std::min(shape, rayPolygon(s.x, s.y, cx, cy, boxCornersX(b), boxCornersY(b)));
@@ -928,11 +879,9 @@ TEST(CastScan, RandomScansMatchBruteForce)
         ++shape_hits;
       }
       if (expected >= s.range_max)
-        ASSERT_EQ(ranges[i], std::numeric_limits<float>::infinity())
-            << "scan " << scans << " beam " << i;
+        ASSERT_EQ(ranges[i], std::numeric_limits<float>::infinity()) << "scan " << scans << " beam " << i;
       else if (expected < s.range_min)
-        ASSERT_EQ(ranges[i], -std::numeric_limits<float>::infinity())
-            << "scan " << scans << " beam " << i;
+        ASSERT_EQ(ranges[i], -std::numeric_limits<float>::infinity()) << "scan " << scans << " beam " << i;
       else
         ASSERT_NEAR(ranges[i], expected, 1e-5) << "scan " << scans << " beam " << i;
     }
@@ -992,8 +941,7 @@ std::vector<uint8_t> blockMap(unsigned w, unsigned h, std::mt19937& rng)
     const unsigned x0 = ux(rng), y0 = uy(rng);
     const unsigned x1 = std::min(w, x0 + usize(rng)), y1 = std::min(h, y0 + usize(rng));
     for (unsigned y = y0; y < y1; ++y)
-      for (unsigned x = x0; x < x1; ++x)
-        cells[y * w + x] = 1;
+      for (unsigned x = x0; x < x1; ++x) cells[y * w + x] = 1;
   }
   return cells;
 }
@@ -1003,8 +951,7 @@ std::vector<uint8_t> caveMap(unsigned w, unsigned h, std::mt19937& rng)
 {
   std::vector<uint8_t> cells(static_cast<size_t>(w) * h, 0);
   std::bernoulli_distribution fill(0.42);
-  for (auto& c : cells)
-    c = fill(rng) ? 1 : 0;
+  for (auto& c : cells) c = fill(rng) ? 1 : 0;
   for (int round = 0; round < 3; ++round)
   {
     std::vector<uint8_t> next(cells.size());
@@ -1016,9 +963,8 @@ std::vector<uint8_t> caveMap(unsigned w, unsigned h, std::mt19937& rng)
           for (int dx = -1; dx <= 1; ++dx)
           {
             const int nx = static_cast<int>(x) + dx, ny = static_cast<int>(y) + dy;
-            around += nx < 0 || ny < 0 || nx >= static_cast<int>(w) || ny >= static_cast<int>(h)
-                          ? 1
-                          : cells[ny * w + nx];
+            around +=
+                nx < 0 || ny < 0 || nx >= static_cast<int>(w) || ny >= static_cast<int>(h) ? 1 : cells[ny * w + nx];
           }
         next[y * w + x] = around >= 5 ? 1 : 0;
       }
@@ -1028,8 +974,8 @@ std::vector<uint8_t> caveMap(unsigned w, unsigned h, std::mt19937& rng)
 }
 
 /// Cast one scan with the given method; directions are cos/sin of the beam angles.
-std::vector<double> castWalls(const GridRaycaster& grid, double x, double y, const Layout& l,
-                              double max_range, WallMethod method, std::vector<double>* dx_out = nullptr,
+std::vector<double> castWalls(const GridRaycaster& grid, double x, double y, const Layout& l, double max_range,
+                              WallMethod method, std::vector<double>* dx_out = nullptr,
                               std::vector<double>* dy_out = nullptr)
 {
   std::vector<double> dx(l.n), dy(l.n), ranges(l.n, -1.0);
@@ -1038,12 +984,9 @@ std::vector<double> castWalls(const GridRaycaster& grid, double x, double y, con
     dx[i] = std::cos(l.first_angle + i * l.increment);
     dy[i] = std::sin(l.first_angle + i * l.increment);
   }
-  grid.castScanWalls(x, y, dx.data(), dy.data(), l.first_angle, l.increment, l.n, max_range,
-                     ranges.data(), method);
-  if (dx_out)
-    *dx_out = dx;
-  if (dy_out)
-    *dy_out = dy;
+  grid.castScanWalls(x, y, dx.data(), dy.data(), l.first_angle, l.increment, l.n, max_range, ranges.data(), method);
+  if (dx_out) *dx_out = dx;
+  if (dy_out) *dy_out = dy;
   return ranges;
 }
 
@@ -1056,11 +999,11 @@ void checkRandomScans(MakeMap make_map, unsigned seed, int* swept_beams)
   const double res = 0.05;
   std::mt19937 rng(seed);
   const std::vector<Layout> layouts = {
-    { 360, -M_PI, 2 * M_PI / 360 },              // the usual full turn
-    { 720, -0.75 * M_PI, 1.5 * M_PI / 720 },     // 270 degrees
-    { 1, 0.3, 0.0 },                             // one beam
-    { 97, 1.0, -0.6 / 96 },                      // a narrow fan turning clockwise
-    { 500, 2.0, 2.5 * M_PI / 499 },              // more than a full turn
+      {360, -M_PI, 2 * M_PI / 360},           // the usual full turn
+      {720, -0.75 * M_PI, 1.5 * M_PI / 720},  // 270 degrees
+      {1, 0.3, 0.0},                          // one beam
+      {97, 1.0, -0.6 / 96},                   // a narrow fan turning clockwise
+      {500, 2.0, 2.5 * M_PI / 499},           // more than a full turn
   };
   std::uniform_real_distribution<double> ux(0.0, w * res), uy(0.0, h * res);
   std::uniform_real_distribution<double> ua(-M_PI, M_PI), ur(0.1, 4.0);
@@ -1071,22 +1014,19 @@ void checkRandomScans(MakeMap make_map, unsigned seed, int* swept_beams)
     for (int scan = 0; scan < 10; ++scan)
     {
       double x = ux(rng), y = uy(rng);
-      if (grid.occupiedAt(x, y))
-        continue;
+      if (grid.occupiedAt(x, y)) continue;
       Layout l = layouts[scan % layouts.size()];
-      l.first_angle += ua(rng);  // the sensor's yaw
+      l.first_angle += ua(rng);                                 // the sensor's yaw
       const double max_range = scan % 3 == 0 ? 10.0 : ur(rng);  // 10 m: leaves the grid
       std::vector<double> dx, dy;
-      const std::vector<double> sweep =
-          castWalls(grid, x, y, l, max_range, WallMethod::kSweep, &dx, &dy);
+      const std::vector<double> sweep = castWalls(grid, x, y, l, max_range, WallMethod::kSweep, &dx, &dy);
       const std::vector<double> walk = castWalls(grid, x, y, l, max_range, WallMethod::kGridWalk);
       const std::vector<double> automatic = castWalls(grid, x, y, l, max_range, WallMethod::kAuto);
       for (int i = 0; i < l.n; ++i)
       {
-        const double expected =
-            bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
-        ASSERT_NEAR(sweep[i], expected, 1e-9) << "map " << map << " scan " << scan << " beam "
-                                              << i << " from (" << x << ", " << y << ")";
+        const double expected = bruteForceGridCastDir(cells, w, h, res, x, y, dx[i], dy[i], max_range);
+        ASSERT_NEAR(sweep[i], expected, 1e-9)
+            << "map " << map << " scan " << scan << " beam " << i << " from (" << x << ", " << y << ")";
         ASSERT_NEAR(sweep[i], walk[i], 1e-9) << "map " << map << " scan " << scan << " beam " << i;
         ASSERT_NEAR(automatic[i], walk[i], 1e-9) << "map " << map << " scan " << scan;
       }
@@ -1101,17 +1041,15 @@ TEST(WallSweep, FacesAreMergedRunsOfCellEdges)
   // One 3 x 2 block in the open: 4 faces (one per side), however many cell edges.
   std::vector<Cell> block;
   for (int y = 5; y < 7; ++y)
-    for (int x = 4; x < 7; ++x)
-      block.push_back({ x, y });
+    for (int x = 4; x < 7; ++x) block.push_back({x, y});
   EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, block).wallFaceCount(), 4u);
   // A wall along the grid's edge: no face on the edge itself (outside is free, and a sensor
   // inside never sees it), one face towards the inside.
   std::vector<Cell> edge;
-  for (int x = 0; x < 12; ++x)
-    edge.push_back({ x, 0 });
+  for (int x = 0; x < 12; ++x) edge.push_back({x, 0});
   EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, edge).wallFaceCount(), 1u);
   // A staircase: every step has its own faces.
-  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, { { 3, 3 }, { 4, 4 } }).wallFaceCount(), 8u);
+  EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, {{3, 3}, {4, 4}}).wallFaceCount(), 8u);
   EXPECT_EQ(makeGrid(12, 12, 0.1, 0.0, 0.0, {}).wallFaceCount(), 0u);
 }
 
@@ -1134,44 +1072,44 @@ TEST(WallSweep, EdgeCasesMatchTheWalk)
   // The room of FanEdgeCases: 4 x 4 m, 0.1 m cells, one-cell walls all round, a wall cell at
   // (20, 10); and the same without the room's walls, where beams leave the grid.
   const double res = 0.1;
-  std::vector<Cell> walls = { { 20, 10 }, { 25, 25 }, { 26, 24 } };
+  std::vector<Cell> walls = {{20, 10}, {25, 25}, {26, 24}};
   for (int k = 0; k < 40; ++k)
   {
-    walls.push_back({ k, 0 });
-    walls.push_back({ k, 39 });
-    walls.push_back({ 0, k });
-    walls.push_back({ 39, k });
+    walls.push_back({k, 0});
+    walls.push_back({k, 39});
+    walls.push_back({0, k});
+    walls.push_back({39, k});
   }
   const GridRaycaster room = makeGrid(40, 40, res, 0.0, 0.0, walls);
-  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, { { 20, 10 }, { 25, 25 } });
+  const GridRaycaster open_grid = makeGrid(40, 40, res, 0.0, 0.0, {{20, 10}, {25, 25}});
   const double d = std::sqrt(0.5);
   // Eight beams, 45 degrees apart, with exact zero components and exact diagonals.
-  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
-  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  const double dx[8] = {1, d, 0, -d, -1, -d, 0, d};
+  const double dy[8] = {0, d, 1, d, 0, -d, -1, -d};
   struct Case
   {
     double x, y, max_range;
     const char* what;
   };
   const std::vector<Case> cases = {
-    { 1.05, 1.05, 8.0, "cell centre: diagonals through cell corners" },
-    { 2.05, 2.05, 8.0, "diagonal passing the corner between (25, 25) and (26, 24)" },
-    { 2.0 - 1e-9, 1.05, 8.0, "1e-9 m left of the wall cell (20, 10)" },
-    { 2.1 + 1e-9, 1.05, 8.0, "1e-9 m right of it" },
-    { 2.05, 1.0 - 1e-9, 8.0, "1e-9 m below it" },
-    { 1.05, 1.05, 0.95, "max range exactly at a wall" },
-    { 1.05, 1.05, 0.95 - 1e-9, "max range just short of a wall" },
-    { 1.05, 1.05, 0.95 + 1e-9, "max range just past a wall" },
-    { 1.05, 1.0, 8.0, "on a grid line: beams along it graze the walls (walk used)" },
-    { 0.1 + 1e-12, 0.1 + 1e-12, 8.0, "a hair off the room's inner corner" },
-    { 2.0, 1.05, 8.0, "on the wall's face (walk used)" },
-    { 2.05, 1.05, 8.0, "inside a wall" },
-    { -1.0, 1.05, 8.0, "outside the grid (walk used)" },
+      {1.05, 1.05, 8.0, "cell centre: diagonals through cell corners"},
+      {2.05, 2.05, 8.0, "diagonal passing the corner between (25, 25) and (26, 24)"},
+      {2.0 - 1e-9, 1.05, 8.0, "1e-9 m left of the wall cell (20, 10)"},
+      {2.1 + 1e-9, 1.05, 8.0, "1e-9 m right of it"},
+      {2.05, 1.0 - 1e-9, 8.0, "1e-9 m below it"},
+      {1.05, 1.05, 0.95, "max range exactly at a wall"},
+      {1.05, 1.05, 0.95 - 1e-9, "max range just short of a wall"},
+      {1.05, 1.05, 0.95 + 1e-9, "max range just past a wall"},
+      {1.05, 1.0, 8.0, "on a grid line: beams along it graze the walls (walk used)"},
+      {0.1 + 1e-12, 0.1 + 1e-12, 8.0, "a hair off the room's inner corner"},
+      {2.0, 1.05, 8.0, "on the wall's face (walk used)"},
+      {2.05, 1.05, 8.0, "inside a wall"},
+      {-1.0, 1.05, 8.0, "outside the grid (walk used)"},
   };
   double got[8], want[8];
-  for (const GridRaycaster* grid : { &room, &open_grid })
+  for (const GridRaycaster* grid : {&room, &open_grid})
     for (const Case& c : cases)
-      for (double first : { 0.0, M_PI })  // the same beams listed from another start
+      for (double first : {0.0, M_PI})  // the same beams listed from another start
       {
         const int shift = first == 0.0 ? 0 : 4;
         double sx[8], sy[8];
@@ -1180,12 +1118,10 @@ TEST(WallSweep, EdgeCasesMatchTheWalk)
           sx[i] = dx[(i + shift) % 8];
           sy[i] = dy[(i + shift) % 8];
         }
-        grid->castScanWalls(c.x, c.y, sx, sy, first, M_PI / 4, 8, c.max_range, got,
-                            WallMethod::kSweep);
+        grid->castScanWalls(c.x, c.y, sx, sy, first, M_PI / 4, 8, c.max_range, got, WallMethod::kSweep);
         grid->castFan(c.x, c.y, sx, sy, 8, c.max_range, want);
         for (int i = 0; i < 8; ++i)
-          ASSERT_NEAR(got[i], want[i], 1e-12) << c.what << ", beam " << i << ", open "
-                                              << (grid == &open_grid);
+          ASSERT_NEAR(got[i], want[i], 1e-12) << c.what << ", beam " << i << ", open " << (grid == &open_grid);
       }
   // The analytic values in the room (as in FanEdgeCases).
   room.castScanWalls(1.05, 1.05, dx, dy, 0.0, M_PI / 4, 8, 8.0, got, WallMethod::kSweep);
@@ -1200,10 +1136,9 @@ TEST(WallSweep, EdgeCasesMatchTheWalk)
   EXPECT_EQ(got[2], 8.0);  // leaves the grid
   EXPECT_EQ(got[4], 8.0);
   // A direction that is not finite is refused, whichever the method.
-  const double bad_x[2] = { 1.0, std::nan("") }, bad_y[2] = { 0.0, 1.0 };
-  for (WallMethod m : { WallMethod::kAuto, WallMethod::kSweep, WallMethod::kGridWalk })
-    EXPECT_THROW(room.castScanWalls(1.05, 1.05, bad_x, bad_y, 0.0, 1.0, 2, 8.0, got, m),
-                 std::invalid_argument);
+  const double bad_x[2] = {1.0, std::nan("")}, bad_y[2] = {0.0, 1.0};
+  for (WallMethod m : {WallMethod::kAuto, WallMethod::kSweep, WallMethod::kGridWalk})
+    EXPECT_THROW(room.castScanWalls(1.05, 1.05, bad_x, bad_y, 0.0, 1.0, 2, 8.0, got, m), std::invalid_argument);
 }
 
 TEST(WallSweep, ScansFromCellCentresAtDiagonalsMatchTheWalk)
@@ -1214,8 +1149,8 @@ TEST(WallSweep, ScansFromCellCentresAtDiagonalsMatchTheWalk)
   const double res = 0.05;
   std::mt19937 rng(9);
   const double d = std::sqrt(0.5);
-  const double dx[8] = { 1, d, 0, -d, -1, -d, 0, d };
-  const double dy[8] = { 0, d, 1, d, 0, -d, -1, -d };
+  const double dx[8] = {1, d, 0, -d, -1, -d, 0, d};
+  const double dy[8] = {0, d, 1, d, 0, -d, -1, -d};
   int compared = 0;
   for (int map = 0; map < 6; ++map)
   {
@@ -1224,15 +1159,13 @@ TEST(WallSweep, ScansFromCellCentresAtDiagonalsMatchTheWalk)
     for (unsigned cy = 0; cy < h; cy += 3)
       for (unsigned cx = 0; cx < w; cx += 3)
       {
-        if (cells[cy * w + cx])
-          continue;
+        if (cells[cy * w + cx]) continue;
         double got[8], want[8];
         const double x = (cx + 0.5) * res, y = (cy + 0.5) * res;
         grid.castScanWalls(x, y, dx, dy, 0.0, M_PI / 4, 8, 3.0, got, WallMethod::kSweep);
         grid.castFan(x, y, dx, dy, 8, 3.0, want);
         for (int i = 0; i < 8; ++i)
-          ASSERT_NEAR(got[i], want[i], 1e-12) << "map " << map << " cell " << cx << ", " << cy
-                                              << " beam " << i;
+          ASSERT_NEAR(got[i], want[i], 1e-12) << "map " << map << " cell " << cx << ", " << cy << " beam " << i;
         compared += 8;
       }
   }
@@ -1247,21 +1180,18 @@ TEST(WallSweep, AnyMethodGivesTheSameScan)
   const unsigned w = 160, h = 120;
   const std::vector<uint8_t> cave = caveMap(w, h, rng);
   std::vector<uint8_t> room(static_cast<size_t>(w) * h, 0);
-  for (unsigned x = 0; x < w; ++x)
-    room[x] = room[(h - 1) * w + x] = 1;
-  for (unsigned y = 0; y < h; ++y)
-    room[y * w] = room[y * w + w - 1] = room[y * w + 80] = y < 90 ? 1 : 0;
-  const Layout l{ 360, -M_PI, 2 * M_PI / 360 };
+  for (unsigned x = 0; x < w; ++x) room[x] = room[(h - 1) * w + x] = 1;
+  for (unsigned y = 0; y < h; ++y) room[y * w] = room[y * w + w - 1] = room[y * w + 80] = y < 90 ? 1 : 0;
+  const Layout l{360, -M_PI, 2 * M_PI / 360};
   std::uniform_real_distribution<double> ux(-2.0, 6.0), uy(1.0, 7.0), ua(-M_PI, M_PI);
-  for (const std::vector<uint8_t>* cells : { &cave, static_cast<const std::vector<uint8_t>*>(&room) })
+  for (const std::vector<uint8_t>* cells : {&cave, static_cast<const std::vector<uint8_t>*>(&room)})
   {
     const GridRaycaster grid(*cells, w, h, 0.05, -2.0, 1.0);
     int scans = 0;
     for (int k = 0; k < 200 && scans < 30; ++k)
     {
       const double x = ux(rng), y = uy(rng);
-      if (grid.occupiedAt(x, y))
-        continue;
+      if (grid.occupiedAt(x, y)) continue;
       ++scans;
       Layout yawed = l;
       yawed.first_angle += ua(rng);

@@ -69,8 +69,10 @@ class SimBasics(unittest.TestCase):
             rec.first_stamped_after(t1, sim_timeout=10.0)  # all of the window has arrived
         for n in names:
             for rec, hz in ((odom[n], 50.0), (scans[n], 10.0), (self.truth[n], 50.0)):
-                stamps = sorted(m.header.stamp.to_sec() for m in rec.stamped_after(t0 - 1e-6) if m.header.stamp.to_sec() < t1)
-                self.assertAlmostEqual(len(stamps), 4.0 * hz, delta=1, msg="%s: %d messages in 4 s" % (rec.sub.name, len(stamps)))
+                stamps = sorted(m.header.stamp.to_sec() for m in rec.stamped_after(t0 - 1e-6)
+                                if m.header.stamp.to_sec() < t1)
+                self.assertAlmostEqual(len(stamps), 4.0 * hz, delta=1,
+                                       msg="%s: %d messages in 4 s" % (rec.sub.name, len(stamps)))
                 gaps = [b - a for a, b in zip(stamps, stamps[1:])]
                 self.assertAlmostEqual(max(gaps), 1.0 / hz, delta=1e-6, msg=rec.sub.name)
                 self.assertAlmostEqual(min(gaps), 1.0 / hz, delta=1e-6, msg=rec.sub.name)
@@ -92,7 +94,8 @@ class SimBasics(unittest.TestCase):
         self.assertEqual(self.clock.latest().clock.to_sec(), paused_at, "sim time moved while paused")
         self.unpause()
         self.truth["robot_0"].first_stamped_after(paused_at + 2.0, sim_timeout=10.0)
-        speeds = [(m.header.stamp.to_sec(), m.twist.twist.linear.x) for m in self.truth["robot_0"].stamped_after(paused_at)]
+        speeds = [(m.header.stamp.to_sec(), m.twist.twist.linear.x)
+                  for m in self.truth["robot_0"].stamped_after(paused_at)]
         stopped_at = next((t for (t, v) in speeds if abs(v) < 1e-6), None)
         self.assertIsNotNone(stopped_at, "the robot never stopped")
         braking_from = max(t for (t, v) in speeds if t < stopped_at and v > 0.3 - 1e-6)
@@ -166,8 +169,10 @@ class SimBasics(unittest.TestCase):
         self.assertEqual(len(discs), 3)
         # robot_1 never moves: its disc is where its ground truth is, footprint-sized
         truth = self.truth["robot_1"].latest().pose.pose.position
-        disc = [m for m in discs.values() if abs(m.pose.position.x - truth.x) < 0.01 and abs(m.pose.position.y - truth.y) < 0.01]
-        self.assertEqual(len(disc), 1, "no disc at robot_1's pose (%.2f, %.2f) at t=%.2f" % (truth.x, truth.y, stamp.to_sec()))
+        disc = [m for m in discs.values()
+                if abs(m.pose.position.x - truth.x) < 0.01 and abs(m.pose.position.y - truth.y) < 0.01]
+        self.assertEqual(len(disc), 1,
+                         "no disc at robot_1's pose (%.2f, %.2f) at t=%.2f" % (truth.x, truth.y, stamp.to_sec()))
         self.assertAlmostEqual(disc[0].scale.x, 2 * RADIUS, delta=1e-6)
 
 

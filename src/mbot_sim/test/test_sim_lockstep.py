@@ -5,7 +5,8 @@ A deliberately slow controller answers every /clock advance past a lockstep boun
 cmd_vel for robot_0, 20 ms (wall) after it saw the boundary. stage_node, which runs about 800x
 faster than real time without lockstep, must hold sim time for it: one cmd_vel releases one
 boundary, so while the test drives, sim time never gets more than one period (+ one physics step,
-for a boundary between two steps) past the last boundary the test answered. Without lockstep sim time runs seconds ahead within the 20 ms.
+for a boundary between two steps) past the last boundary the test answered. Without lockstep sim time
+runs seconds ahead within the 20 ms.
 When the test stops sending, robot_0 is no longer waited for: sim time runs on (> 5 s sim within
 a few wall seconds), it does not hang.
 

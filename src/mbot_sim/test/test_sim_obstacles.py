@@ -6,7 +6,6 @@ block at x = 7.0. A box spawned in between shows in the first scan measured afte
 is gone from the first scan measured after its removal. The sim time of each change is the stamp
 of the /stage/markers array stage_node publishes with it. Refused requests change nothing.
 """
-import math
 import sys
 import unittest
 
@@ -111,7 +110,8 @@ class SimObstacles(unittest.TestCase):
         before, after = self.scans_around(t_spawn)
         self.assertAlmostEqual(before.ranges[ahead], wall, delta=res)
         self.assertAlmostEqual(after.ranges[ahead], box, delta=res,
-                               msg="first scan after the spawn: %.3f m, the box is at %.3f m" % (after.ranges[ahead], box))
+                               msg="first scan after the spawn: %.3f m, the box is at %.3f m"
+                               % (after.ranges[ahead], box))
 
         # ---- refused spawns change nothing
         refused = [
@@ -144,7 +144,8 @@ class SimObstacles(unittest.TestCase):
         self.assertGreaterEqual(len(scans), 10)
         for s in scans:
             self.assertAlmostEqual(s.ranges[ahead], box, delta=res, msg="t = %.2f" % s.header.stamp.to_sec())
-        latest = self.wait_for_markers(lambda a: stamp_of(a) >= last.header.stamp.to_sec(), "markers after the refusals")
+        latest = self.wait_for_markers(lambda a: stamp_of(a) >= last.header.stamp.to_sec(),
+                                       "markers after the refusals")
         self.assertEqual(sorted(obstacle_markers(latest)), ["crate"])
 
         # ---- remove: the wall again from the first scan measured after it
@@ -160,9 +161,11 @@ class SimObstacles(unittest.TestCase):
         before, after = self.scans_around(t_remove)
         self.assertAlmostEqual(before.ranges[ahead], box, delta=res)
         self.assertAlmostEqual(after.ranges[ahead], wall, delta=res,
-                               msg="first scan after the removal: %.3f m, the wall is at %.3f m" % (after.ranges[ahead], wall))
+                               msg="first scan after the removal: %.3f m, the wall is at %.3f m"
+                               % (after.ranges[ahead], wall))
 
-        for name, expected in (("crate", 'unknown obstacle "crate"'), ("robot_1", '"robot_1" is a robot, not an obstacle'),
+        for name, expected in (("crate", 'unknown obstacle "crate"'),
+                               ("robot_1", '"robot_1" is a robot, not an obstacle'),
                                ("map", '"map" is the walls, not an obstacle')):
             res_bad = self.remove(name=name)
             self.assertFalse(res_bad.success, "remove %s should fail" % name)

@@ -429,12 +429,12 @@ TEST(Walker, StepsAroundARobotStandingOnItsPathAndStillReachesItsWaypoints)
     World world(openMap(), WorldSettings{});
     world.addMovingObstacle(walkerConfig("person_1", route, yielding));
     const int robot = world.addRobot("robot_0", diffModel(), Pose2D{0.0, 0.0, 0.0});  // on the path
-    const WalkLog log = walk(world, 0, route, 0.0, robot, 30.0);  // there and back: 20 s alone
+    const WalkLog log = walk(world, 0, route, 0.0, robot, 30.0);                      // there and back: 20 s alone
     EXPECT_EQ(log.contacts, 0u) << "yielding " << yielding;
     EXPECT_GT(log.min_gap, 0.04) << "yielding " << yielding;
     for (double d : log.closest_to_waypoint) EXPECT_LT(d, 0.01) << "yielding " << yielding;
     EXPECT_GT(log.max_deviation, 0.4) << "yielding " << yielding;  // around, not through
-    EXPECT_NEAR(world.groundTruth(robot).x, 0.0, 1e-9);  // and it never pushed the robot
+    EXPECT_NEAR(world.groundTruth(robot).x, 0.0, 1e-9);            // and it never pushed the robot
   }
   // Blind (yielding 0), the same walk runs into the robot: what the walker above avoids.
   World world(openMap(), WorldSettings{});
@@ -551,10 +551,10 @@ TEST(Sensors, LaserSeesWallsRobotsAndObstaclesAtTheirDistance)
   ASSERT_EQ(rec.scans[id].size(), 1u);
   const std::vector<float>& r = rec.scans[id][0].ranges;
   ASSERT_EQ(r.size(), 360u);
-  EXPECT_NEAR(r[beamAt(model, kPi)], 2.05 - 0.1, 0.05);        // west wall (inner face x = 0.1)
-  EXPECT_NEAR(r[beamAt(model, -kPi / 2)], 4.0 - 0.1, 0.05);    // south wall
-  EXPECT_NEAR(r[beamAt(model, 0.0)], 3.0 - 0.15 - 2.05, 1e-3); // robot_1's body
-  EXPECT_NEAR(r[beamAt(model, kPi / 2)], 1.8, 1e-3);           // the crate
+  EXPECT_NEAR(r[beamAt(model, kPi)], 2.05 - 0.1, 0.05);         // west wall (inner face x = 0.1)
+  EXPECT_NEAR(r[beamAt(model, -kPi / 2)], 4.0 - 0.1, 0.05);     // south wall
+  EXPECT_NEAR(r[beamAt(model, 0.0)], 3.0 - 0.15 - 2.05, 1e-3);  // robot_1's body
+  EXPECT_NEAR(r[beamAt(model, kPi / 2)], 1.8, 1e-3);            // the crate
   // The robot's own body is not seen: no beam is shorter than the walls around it allow.
   for (float v : r) EXPECT_GT(v, 0.5);
 }
@@ -569,7 +569,7 @@ TEST(Sensors, RatesFollowTheModelInSimTime)
   EXPECT_EQ(rec.odom[id].size(), 100u);   // 50 Hz
   EXPECT_EQ(rec.truth[id].size(), 100u);  // 50 Hz
   EXPECT_EQ(rec.joints[id].size(), 100u);
-  EXPECT_EQ(rec.scans[id].size(), 20u);   // 10 Hz
+  EXPECT_EQ(rec.scans[id].size(), 20u);  // 10 Hz
   EXPECT_NEAR(rec.scans[id][1].stamp - rec.scans[id][0].stamp, 0.1, 1e-9);
   EXPECT_NEAR(rec.odom[id][1].stamp - rec.odom[id][0].stamp, 0.02, 1e-9);
 }
@@ -794,7 +794,7 @@ TEST(Requests, SpawnTeleportRemoveAndTheirErrors)
   World world(roomMap(), WorldSettings{});
   const RobotModel model = diffModel();
   world.addRobot("robot_0", model, Pose2D{2.0, 2.0, 0.0});
-  EXPECT_THROW(world.addRobot("robot_0", model, Pose2D{4.0, 4.0, 0.0}), SimError);  // duplicate
+  EXPECT_THROW(world.addRobot("robot_0", model, Pose2D{4.0, 4.0, 0.0}), SimError);   // duplicate
   EXPECT_THROW(world.addRobot("robot_1", model, Pose2D{0.05, 4.0, 0.0}), SimError);  // in a wall
   EXPECT_THROW(world.addRobot("robot_1", model, Pose2D{2.2, 2.0, 0.0}), SimError);   // on robot_0
   EXPECT_THROW(world.addRobot("map", model, Pose2D{4.0, 4.0, 0.0}), SimError);       // the walls' name
@@ -878,7 +878,7 @@ TEST(Requests, SpawnedObstacleIsSeenFromTheNextScanAndGoneAfterRemoval)
   const int id = world.addRobot("robot_0", model, Pose2D{4.0, 4.0, 0.0});  // laser at x = 4.05
   const size_t ahead = beamAt(model, 0.0), left = beamAt(model, kPi / 2);
   const double wall_ahead = 9.9 - 4.05, wall_left = 7.9 - 4.0;  // east and north inner faces
-  run(world, 0.15);  // between two scans (0.1 s, 0.2 s)
+  run(world, 0.15);                                             // between two scans (0.1 s, 0.2 s)
   ASSERT_EQ(rec.scans[id].size(), 1u);
   EXPECT_NEAR(rec.scans[id][0].ranges[ahead], wall_ahead, 1e-3);
 
@@ -1082,11 +1082,11 @@ TEST(Walls, RoomFixtureHasWallsAroundAndFreeInside)
   ASSERT_EQ(map.width, 200u);
   ASSERT_EQ(map.height, 160u);
   EXPECT_EQ(map.at(0, 0), 100);
-  EXPECT_EQ(map.at(1, 80), 100);     // x = 0.075 m: inside the 0.1 m west wall
-  EXPECT_EQ(map.at(2, 80), 0);       // x = 0.125 m: free
-  EXPECT_EQ(map.at(100, 80), 0);     // the middle
-  EXPECT_EQ(map.at(145, 30), 100);   // x = 7.25, y = 1.5: the wall block
-  EXPECT_EQ(map.at(145, 70), 0);     // x = 7.25, y = 3.5: above the block
+  EXPECT_EQ(map.at(1, 80), 100);    // x = 0.075 m: inside the 0.1 m west wall
+  EXPECT_EQ(map.at(2, 80), 0);      // x = 0.125 m: free
+  EXPECT_EQ(map.at(100, 80), 0);    // the middle
+  EXPECT_EQ(map.at(145, 30), 100);  // x = 7.25, y = 1.5: the wall block
+  EXPECT_EQ(map.at(145, 70), 0);    // x = 7.25, y = 3.5: above the block
 }
 
 TEST(Walls, MergedRectanglesCoverExactlyTheOccupiedCells)

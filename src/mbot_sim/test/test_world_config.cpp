@@ -53,7 +53,7 @@ TEST(WorldConfig, ReadsEveryKey)
 {
   const WorldConfig c = mbot_sim::loadWorldConfig(kFixtures + "/full.world.yaml");
   EXPECT_EQ(c.map_path, kFixtures + "/room.yaml");  // relative to the world file
-  EXPECT_EQ(c.map_data.width, 200u);                 // loaded
+  EXPECT_EQ(c.map_data.width, 200u);                // loaded
   EXPECT_DOUBLE_EQ(c.physics_step, 0.005);
   EXPECT_DOUBLE_EQ(c.real_time_factor, 0.0);
   EXPECT_EQ(c.seed, 7u);
@@ -111,7 +111,8 @@ TEST(WorldConfig, EachInvalidFixtureGivesItsMessage)
       {"invalid_duplicate_robot.world.yaml", "robots[1].name: duplicate name \"robot_0\""},
       {"invalid_robot_in_wall.world.yaml", "robots[0].pose: robot robot_0 at (7.20, 1.00) overlaps a wall"},
       {"invalid_robot_overlap.world.yaml", "robots[1].pose: robot robot_1 at (2.20, 2.00) overlaps robot robot_0"},
-      {"invalid_robot_on_obstacle.world.yaml", "robots[0].pose: robot robot_0 at (2.30, 2.00) overlaps obstacle crate_1"},
+      {"invalid_robot_on_obstacle.world.yaml",
+       "robots[0].pose: robot robot_0 at (2.30, 2.00) overlaps obstacle crate_1"},
       {"invalid_robot_outside.world.yaml", "robots[0].pose: robot robot_0 at (20.00, 2.00) is outside the map"},
       {"invalid_model.world.yaml", "robots[0].model: cannot load model \"hovercraft\": no model named hovercraft"},
       {"invalid_speed.world.yaml", "moving_obstacles[0].speed: expected a number > 0 [m/s], got \"-0.5\""},
@@ -135,8 +136,8 @@ TEST(WorldConfig, EachInvalidFixtureGivesItsMessage)
   {
     const std::string message = worldError(c.file);
     const std::string expected = kFixtures + "/" + c.file + ": " + c.message;
-    EXPECT_NE(message.find(expected), std::string::npos) << "fixture " << c.file << "\n  got:      " << message
-                                                        << "\n  expected: " << expected;
+    EXPECT_NE(message.find(expected), std::string::npos)
+        << "fixture " << c.file << "\n  got:      " << message << "\n  expected: " << expected;
     EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
   }
 }

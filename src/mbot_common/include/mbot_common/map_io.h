@@ -43,14 +43,14 @@ const char* mapModeName(MapMode mode);
 /// @brief An occupancy map as map_server publishes it, and the yaml fields it came from.
 struct OccupancyMap
 {
-  std::string yaml_path;         ///< the map yaml as given
-  std::string image_path;        ///< the PGM (relative to the yaml's directory when relative there)
-  unsigned width = 0;            ///< [cells]
-  unsigned height = 0;           ///< [cells]
-  double resolution = 0.05;      ///< [m/cell]
-  double origin_x = 0.0;         ///< lower-left corner of cell (0, 0) in the map frame [m]
-  double origin_y = 0.0;         ///< [m]
-  double origin_yaw = 0.0;       ///< [rad]
+  std::string yaml_path;          ///< the map yaml as given
+  std::string image_path;         ///< the PGM (relative to the yaml's directory when relative there)
+  unsigned width = 0;             ///< [cells]
+  unsigned height = 0;            ///< [cells]
+  double resolution = 0.05;       ///< [m/cell]
+  double origin_x = 0.0;          ///< lower-left corner of cell (0, 0) in the map frame [m]
+  double origin_y = 0.0;          ///< [m]
+  double origin_yaw = 0.0;        ///< [rad]
   double occupied_thresh = 0.65;  ///< occupancy probability above which a cell is occupied [0, 1]
   double free_thresh = 0.196;     ///< occupancy probability below which a cell is free [0, 1]
   bool negate = false;            ///< true: white is occupied, black free

@@ -81,8 +81,7 @@ public:
     {
       if (name.compare(0, prefix.size(), prefix) != 0) continue;
       const std::string key = name.substr(prefix.size(), name.find('/', prefix.size()) - prefix.size());
-      if (known_.count(key) == 0 && unknown.find(" " + key + ",") == std::string::npos)
-        unknown += " " + key + ",";
+      if (known_.count(key) == 0 && unknown.find(" " + key + ",") == std::string::npos) unknown += " " + key + ",";
     }
     if (unknown.empty()) return;
     std::string known;
@@ -104,11 +103,9 @@ private:
     return nh_.getParam(key, v);
   }
 
-  std::runtime_error wrongType(const std::string& key, const std::string& expected,
-                               const XmlRpc::XmlRpcValue& v) const
+  std::runtime_error wrongType(const std::string& key, const std::string& expected, const XmlRpc::XmlRpcValue& v) const
   {
-    return std::runtime_error("parameter " + nh_.resolveName(key) + ": expected " + expected + ", got " +
-                              typeName(v));
+    return std::runtime_error("parameter " + nh_.resolveName(key) + ": expected " + expected + ", got " + typeName(v));
   }
 
   static const char* typeName(const XmlRpc::XmlRpcValue& v)

@@ -173,10 +173,7 @@ public:
 
 private:
   /// A missing key (an invalid node) is not a scalar: yaml-cpp would throw on IsScalar().
-  static bool isPlainScalar(const YAML::Node& node)
-  {
-    return node.IsDefined() && node.IsScalar() && node.Tag() != "!";
-  }
+  static bool isPlainScalar(const YAML::Node& node) { return node.IsDefined() && node.IsScalar() && node.Tag() != "!"; }
 
   static std::string list(const std::vector<std::string>& keys)
   {

@@ -41,10 +41,10 @@ struct ShapeConfig
 /// @brief One robot of the world file.
 struct RobotConfig
 {
-  std::string name;             ///< namespace and frame prefix
-  std::string model = "mbot";   ///< mbot_description model name
-  Pose2D pose;                  ///< start pose in the map frame
-  std::string key;              ///< where it came from in the file, e.g. "robots[1]" (for messages)
+  std::string name;            ///< namespace and frame prefix
+  std::string model = "mbot";  ///< mbot_description model name
+  Pose2D pose;                 ///< start pose in the map frame
+  std::string key;             ///< where it came from in the file, e.g. "robots[1]" (for messages)
 };
 
 /// @brief A static box or cylinder besides the map walls.
@@ -107,13 +107,13 @@ struct RobotFaultConfig
 /// @brief Everything a world file says. Paths are resolved relative to the world file.
 struct WorldConfig
 {
-  std::string file;                  ///< the world file as given (for messages)
-  std::string map;                   ///< the map entry as written in the file
-  std::string map_path;              ///< the map_server yaml: `map` relative to the world file's directory
-  OccupancyMap map_data;             ///< the loaded map
-  double physics_step = 0.01;        ///< [s]
-  double real_time_factor = 1.0;     ///< sim seconds per wall second; 0 = as fast as possible
-  unsigned seed = 0;                 ///< seed of every random draw
+  std::string file;               ///< the world file as given (for messages)
+  std::string map;                ///< the map entry as written in the file
+  std::string map_path;           ///< the map_server yaml: `map` relative to the world file's directory
+  OccupancyMap map_data;          ///< the loaded map
+  double physics_step = 0.01;     ///< [s]
+  double real_time_factor = 1.0;  ///< sim seconds per wall second; 0 = as fast as possible
+  unsigned seed = 0;              ///< seed of every random draw
   std::vector<RobotConfig> robots;
   std::vector<ObstacleConfig> obstacles;
   std::vector<MovingObstacleConfig> moving_obstacles;

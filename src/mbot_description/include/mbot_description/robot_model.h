@@ -38,17 +38,17 @@ struct Point2
 /// @brief Planar laser settings (model settings file) and mount (URDF).
 struct LaserSpec
 {
-  int beams = 360;             ///< number of beams
+  int beams = 360;                       ///< number of beams
   double min_angle = -3.14159265358979;  ///< first beam [rad]
   double max_angle = 3.14159265358979;   ///< last beam [rad]; for a full circle the beams are
                                          ///< spaced 2*pi/beams and the last is not a repeat
-  double range_min = 0.12;     ///< [m]
-  double range_max = 8.0;      ///< [m]
-  double rate = 10.0;          ///< [Hz]
-  double mount_x = 0.0;        ///< laser origin in base_footprint [m]
-  double mount_y = 0.0;        ///< [m]
-  double mount_z = 0.0;        ///< [m]
-  double mount_yaw = 0.0;      ///< [rad]
+  double range_min = 0.12;               ///< [m]
+  double range_max = 8.0;                ///< [m]
+  double rate = 10.0;                    ///< [Hz]
+  double mount_x = 0.0;                  ///< laser origin in base_footprint [m]
+  double mount_y = 0.0;                  ///< [m]
+  double mount_z = 0.0;                  ///< [m]
+  double mount_yaw = 0.0;                ///< [rad]
 
   /// @brief Angle between neighbouring beams [rad]: 2*pi/beams for a full circle (the last beam
   ///        is not a repeat of the first), else (max_angle - min_angle) / (beams - 1).
@@ -65,31 +65,31 @@ struct LaserSpec
 /// @brief Velocity and acceleration limits, named as dwa_local_planner names them.
 struct Limits
 {
-  double max_vel_x = 0.5;       ///< [m/s]
-  double min_vel_x = -0.2;      ///< [m/s] (negative: may back up)
-  double max_vel_y = 0.0;       ///< [m/s] (0 for a diff-drive robot)
-  double max_vel_theta = 2.0;   ///< [rad/s]
-  double acc_lim_x = 1.0;       ///< [m/s^2]
-  double acc_lim_y = 0.0;       ///< [m/s^2]
-  double acc_lim_theta = 3.0;   ///< [rad/s^2]
+  double max_vel_x = 0.5;      ///< [m/s]
+  double min_vel_x = -0.2;     ///< [m/s] (negative: may back up)
+  double max_vel_y = 0.0;      ///< [m/s] (0 for a diff-drive robot)
+  double max_vel_theta = 2.0;  ///< [rad/s]
+  double acc_lim_x = 1.0;      ///< [m/s^2]
+  double acc_lim_y = 0.0;      ///< [m/s^2]
+  double acc_lim_theta = 3.0;  ///< [rad/s^2]
 };
 
 /// @brief Everything the simulator and the navigation need to know about one robot model.
 struct RobotModel
 {
-  std::string name;                    ///< "mbot" or "mbot_omni"
+  std::string name;  ///< "mbot" or "mbot_omni"
   DriveType drive = DriveType::DIFF;
-  double footprint_radius = 0.0;       ///< radius of the circle around the footprint [m]
-  std::vector<Point2> footprint;       ///< footprint polygon in base_footprint, counter-clockwise [m]
-  double mass = 0.0;                   ///< total mass [kg] (sum of URDF link masses)
-  double wheel_radius = 0.0;           ///< [m]
-  double wheel_separation = 0.0;       ///< distance between left and right wheels [m]
-  double wheel_base = 0.0;             ///< distance between front and rear wheels [m] (0: one axle)
+  double footprint_radius = 0.0;          ///< radius of the circle around the footprint [m]
+  std::vector<Point2> footprint;          ///< footprint polygon in base_footprint, counter-clockwise [m]
+  double mass = 0.0;                      ///< total mass [kg] (sum of URDF link masses)
+  double wheel_radius = 0.0;              ///< [m]
+  double wheel_separation = 0.0;          ///< distance between left and right wheels [m]
+  double wheel_base = 0.0;                ///< distance between front and rear wheels [m] (0: one axle)
   std::vector<std::string> wheel_joints;  ///< unprefixed URDF joint names of the driven wheels
   LaserSpec laser;
   Limits limits;
-  double odom_rate = 50.0;             ///< [Hz]
-  double ground_truth_rate = 50.0;     ///< [Hz]
+  double odom_rate = 50.0;          ///< [Hz]
+  double ground_truth_rate = 50.0;  ///< [Hz]
 };
 
 /// @brief Load `<description_dir>/urdf/<model>.urdf` and `<description_dir>/config/<model>.yaml`.

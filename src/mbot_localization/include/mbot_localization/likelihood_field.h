@@ -74,7 +74,6 @@ private:
 /// @param occupied width * height flags, row-major; the result is 0 on occupied cells and the
 ///        squared distance to the nearest occupied cell centre elsewhere (a huge value when
 ///        there is no occupied cell at all)
-std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width,
-                                             unsigned height);
+std::vector<double> squaredDistanceTransform(const std::vector<uint8_t>& occupied, unsigned width, unsigned height);
 
 }  // namespace mbot_localization

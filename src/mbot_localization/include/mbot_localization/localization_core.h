@@ -28,10 +28,10 @@ struct PfLocalizerConfig
   ParticleFilterConfig filter;
   MotionModelConfig motion;
   LaserModelConfig laser;
-  double update_min_d = 0.2;        ///< update_min_d: travel [m] before a filter update
-  double update_min_a = M_PI / 6.0; ///< update_min_a: rotation [rad] before a filter update
-  int resample_interval = 2;        ///< resample_interval: filter updates per resampling
-  double likelihood_max_dist = 2.0; ///< laser_likelihood_max_dist [m]
+  double update_min_d = 0.2;         ///< update_min_d: travel [m] before a filter update
+  double update_min_a = M_PI / 6.0;  ///< update_min_a: rotation [rad] before a filter update
+  int resample_interval = 2;         ///< resample_interval: filter updates per resampling
+  double likelihood_max_dist = 2.0;  ///< laser_likelihood_max_dist [m]
 };
 
 /// @brief The AMCL-like localization cycle for one robot.
@@ -145,8 +145,8 @@ private:
 
   int64_t buffer_ns_;
   int64_t tolerance_ns_;
-  std::deque<StampedPose> truth_;  ///< ascending stamps
-  std::deque<StampedPose> odom_;   ///< waiting for their ground truth, ascending stamps
+  std::deque<StampedPose> truth_;      ///< ascending stamps
+  std::deque<StampedPose> odom_;       ///< waiting for their ground truth, ascending stamps
   int64_t last_truth_ns_ = INT64_MIN;  ///< newest stamp seen on each topic
   int64_t last_odom_ns_ = INT64_MIN;
   int time_jumps_ = 0;

@@ -15,11 +15,11 @@
 
 namespace mbot_localization
 {
-using mbot_common::Pose2D;          // {x, y, theta} [m, m, rad]
 using mbot_common::angleDiff;       // smallest signed difference a - b [rad], in (-pi, pi]
 using mbot_common::compose;         // a * b: pose b (given in a's frame) in a's parent frame
 using mbot_common::inverse;         // the parent frame expressed in a's frame
 using mbot_common::normalizeAngle;  // wrap to (-pi, pi]
+using mbot_common::Pose2D;          // {x, y, theta} [m, m, rad]
 
 /// @brief The map -> odom correction that makes odom_base land on map_base:
 ///        T_map_odom = T_map_base * inverse(T_odom_base).

@@ -57,8 +57,7 @@ public:
 
   /// @brief Move all particles by the odometry change from `odom_old` to `odom_new` (both the
   ///        base pose in the odom frame [m, m, rad]), drawing noise from `rng`.
-  void apply(const Pose2D& odom_old, const Pose2D& odom_new, std::vector<Particle>& particles,
-             std::mt19937& rng) const;
+  void apply(const Pose2D& odom_old, const Pose2D& odom_new, std::vector<Particle>& particles, std::mt19937& rng) const;
 
   const MotionModelConfig& config() const { return config_; }
 
@@ -84,12 +83,12 @@ struct LaserScanData
 /// @brief Parameters of the likelihood-field model, amcl's laser_* names.
 struct LaserModelConfig
 {
-  double z_hit = 0.95;     ///< laser_z_hit: weight of the Gaussian "hit" part
-  double z_rand = 0.05;    ///< laser_z_rand: weight of the uniform "random reading" part
-  double sigma_hit = 0.2;  ///< laser_sigma_hit: std dev of the hit Gaussian [m]
-  int max_beams = 30;      ///< laser_max_beams: beams used per scan (evenly spread)
-  double min_range = -1.0; ///< laser_min_range [m]; <= 0: use the scan's range_min
-  double max_range = -1.0; ///< laser_max_range [m]; <= 0: use the scan's range_max
+  double z_hit = 0.95;      ///< laser_z_hit: weight of the Gaussian "hit" part
+  double z_rand = 0.05;     ///< laser_z_rand: weight of the uniform "random reading" part
+  double sigma_hit = 0.2;   ///< laser_sigma_hit: std dev of the hit Gaussian [m]
+  int max_beams = 30;       ///< laser_max_beams: beams used per scan (evenly spread)
+  double min_range = -1.0;  ///< laser_min_range [m]; <= 0: use the scan's range_min
+  double max_range = -1.0;  ///< laser_max_range [m]; <= 0: use the scan's range_max
 };
 
 /// @brief Likelihood-field laser model (Probabilistic Robotics, table 6.3), as amcl's
@@ -104,15 +103,13 @@ public:
   /// @brief Multiply every particle's weight by the likelihood of `scan` seen from it.
   /// @param laser_in_base the laser frame in the robot's base frame [m, m, rad]
   /// @return the sum of the new weights
-  double apply(const LaserScanData& scan, const Pose2D& laser_in_base,
-               std::vector<Particle>& particles) const;
+  double apply(const LaserScanData& scan, const Pose2D& laser_in_base, std::vector<Particle>& particles) const;
 
   /// @brief The (unnormalized) likelihood of `scan` for one robot pose in the map.
   ///
   /// As amcl, beam scores are combined as 1 + sum(p^3) instead of a product: a product of
   /// hundreds of correlated beams makes the filter overconfident; the cube keeps the contrast.
-  double likelihood(const LaserScanData& scan, const Pose2D& laser_in_base,
-                    const Pose2D& base_in_map) const;
+  double likelihood(const LaserScanData& scan, const Pose2D& laser_in_base, const Pose2D& base_in_map) const;
 
   const LaserModelConfig& config() const { return config_; }
   const LikelihoodField& field() const { return *field_; }

@@ -17,9 +17,9 @@ namespace mbot_localization
 {
 // Strict parameters, the robot's name and frames, and the pose conversions are shared with the
 // map server and the nav node (mbot_common/ros_edge.h); the nodes here use them unqualified.
-using mbot_common::StrictParams;
 using mbot_common::prefixedFrame;
 using mbot_common::robotName;
+using mbot_common::StrictParams;
 using mbot_common::toPose2D;
 using mbot_common::toPoseMsg;
 using mbot_common::toTransformMsg;

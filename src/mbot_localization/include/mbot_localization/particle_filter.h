@@ -28,7 +28,7 @@ struct ParticleFilterConfig
   int min_particles = 100;
   int max_particles = 5000;
   int particles_per_bin = 50;
-  double bin_size_xy = 0.5;              ///< [m] (amcl's pf histogram bins)
+  double bin_size_xy = 0.5;                     ///< [m] (amcl's pf histogram bins)
   double bin_size_theta = 10.0 * M_PI / 180.0;  ///< [rad]
 };
 
@@ -72,7 +72,6 @@ private:
 /// @brief Low-variance (systematic) resampling: `count` indices into `weights` (normalized),
 ///        drawn with one random offset so that index i is picked floor or ceil of
 ///        count * weights[i] times.
-std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count,
-                                      std::mt19937& rng);
+std::vector<size_t> lowVarianceSample(const std::vector<double>& weights, size_t count, std::mt19937& rng);
 
 }  // namespace mbot_localization

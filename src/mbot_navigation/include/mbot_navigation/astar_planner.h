@@ -81,11 +81,11 @@ struct AStarConfig
 /// @brief Figures about the last makePlan() call (for benches and tests).
 struct AStarStats
 {
-  size_t expanded = 0;             ///< cells taken off the open list
-  size_t grid_path_cells = 0;      ///< cells in the 8-connected grid path
-  double grid_path_length = 0.0;   ///< [cells] length of the grid path
-  double path_length = 0.0;        ///< [cells] length of the returned (smoothed) path
-  double grid_path_cost = 0.0;     ///< [cost units] cost of the grid path
+  size_t expanded = 0;            ///< cells taken off the open list
+  size_t grid_path_cells = 0;     ///< cells in the 8-connected grid path
+  double grid_path_length = 0.0;  ///< [cells] length of the grid path
+  double path_length = 0.0;       ///< [cells] length of the returned (smoothed) path
+  double grid_path_cost = 0.0;    ///< [cost units] cost of the grid path
 };
 
 /// @brief 8-connected cost-aware A* + line-of-sight smoothing (see the file comment).
@@ -149,9 +149,9 @@ private:
   double lineCost(const uint8_t* costs, uint32_t a, uint32_t b, double& cell_sum) const;
 
   AStarConfig config_;
-  float weight_[256];       ///< neutral_cost + cost_factor * c per cost value; +inf if impassable
+  float weight_[256];  ///< neutral_cost + cost_factor * c per cost value; +inf if impassable
   unsigned size_x_ = 0, size_y_ = 0;
-  int offset_[8];           ///< index offsets of the 8 neighbours
+  int offset_[8];  ///< index offsets of the 8 neighbours
   uint32_t generation_ = 0;
   std::vector<Node> nodes_;
   /**
@@ -217,9 +217,9 @@ private:
       size_t head = 0;
     };
     std::vector<Bucket> buckets_;  ///< reused: no allocation once warm
-    uint64_t mask_ = 0;  ///< ring size - 1 (a power of two)
-    uint64_t low_ = 0;   ///< no queued cell is in a bucket below this one
-    uint64_t high_ = 0;  ///< nor above this one
+    uint64_t mask_ = 0;            ///< ring size - 1 (a power of two)
+    uint64_t low_ = 0;             ///< no queued cell is in a bucket below this one
+    uint64_t high_ = 0;            ///< nor above this one
     float inv_width_ = 1.0f;
   };
   OpenList open_;

@@ -35,10 +35,13 @@ public:
   Costmap2D() = default;
   Costmap2D(unsigned size_x, unsigned size_y, double resolution, double origin_x, double origin_y,
             uint8_t default_cost = cost::FREE)
-    : size_x_(size_x), size_y_(size_y), resolution_(resolution), origin_x_(origin_x),
-      origin_y_(origin_y), costs_(static_cast<size_t>(size_x) * size_y, default_cost)
-  {
-  }
+      : size_x_(size_x),
+        size_y_(size_y),
+        resolution_(resolution),
+        origin_x_(origin_x),
+        origin_y_(origin_y),
+        costs_(static_cast<size_t>(size_x) * size_y, default_cost)
+  {}
 
   unsigned sizeX() const { return size_x_; }
   unsigned sizeY() const { return size_y_; }

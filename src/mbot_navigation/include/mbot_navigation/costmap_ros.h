@@ -74,7 +74,7 @@ struct CostmapRosSettings
 
   bool robots_layer = true;
   RobotsLayerConfig robots;
-  double robots_padding = 0.1;      ///< [m]
+  double robots_padding = 0.1;       ///< [m]
   double robots_scan_margin = 0.15;  ///< [m]
 };
 

@@ -82,11 +82,11 @@ private:
   /// (mx, my). Memoised per cell for the cycle: many samples pass over the same cells.
   bool footprintHitsLethal(unsigned mx, unsigned my);
 
-  double footprint_radius_;          ///< [m]
-  const Costmap2D* costmap_ = nullptr;  ///< the costmap of this cycle (set by prepare)
-  double offsets_resolution_ = 0.0;  ///< [m/cell] the offsets below were computed for
+  double footprint_radius_;                        ///< [m]
+  const Costmap2D* costmap_ = nullptr;             ///< the costmap of this cycle (set by prepare)
+  double offsets_resolution_ = 0.0;                ///< [m/cell] the offsets below were computed for
   std::vector<std::pair<int, int>> disc_offsets_;  ///< cells under the footprint, relative [cells]
-  std::vector<uint8_t> lethal_memo_;  ///< per cell: 0 unknown, 1 clear, 2 a lethal cell underneath
+  std::vector<uint8_t> lethal_memo_;               ///< per cell: 0 unknown, 1 clear, 2 a lethal cell underneath
 };
 
 /**
@@ -97,9 +97,9 @@ private:
  * The map holds distances in cells (wavefront steps); the score is that distance times the
  * resolution [m], so that the scale is the bias itself (dwa scales by bias * resolution instead).
  * Cells with a cost >= INSCRIBED are obstacles (and never targets, unlike MapGrid's), cells the
- * wavefront does not reach are unreachable. With `stop_on_failure`, a trajectory that touches an obstacle or an unreachable
- * cell is rejected. `forward_shift` [m] scores the point that far ahead of the pose (the robot's
- * "nose") instead of the pose itself. A scored point off the map rejects the trajectory.
+ * wavefront does not reach are unreachable. With `stop_on_failure`, a trajectory that touches an obstacle or an
+ * unreachable cell is rejected. `forward_shift` [m] scores the point that far ahead of the pose (the robot's "nose")
+ * instead of the pose itself. A scored point off the map rejects the trajectory.
  */
 class MapGridCritic : public TrajectoryCritic
 {
@@ -129,8 +129,8 @@ private:
   bool stop_on_failure_;
   const Costmap2D* costmap_ = nullptr;
   unsigned size_x_ = 0;
-  uint32_t obstacle_ = 0;     ///< map value of an obstacle cell (cells in the map)
-  uint32_t unreachable_ = 0;  ///< map value of a cell the wavefront did not reach (obstacle_ + 1)
+  uint32_t obstacle_ = 0;        ///< map value of an obstacle cell (cells in the map)
+  uint32_t unreachable_ = 0;     ///< map value of a cell the wavefront did not reach (obstacle_ + 1)
   std::vector<uint32_t> dist_;   ///< [cells]
   std::vector<uint32_t> queue_;  ///< wavefront queue (cell indices), kept to avoid reallocation
 };
@@ -162,10 +162,9 @@ class PathAlignCritic : public MapGridCritic
 {
 public:
   PathAlignCritic(double scale, double forward_point_distance)
-    : MapGridCritic(scale, Target::PATH, forward_point_distance, false),
-      forward_point_distance_(forward_point_distance)
-  {
-  }
+      : MapGridCritic(scale, Target::PATH, forward_point_distance, false),
+        forward_point_distance_(forward_point_distance)
+  {}
   std::string name() const override { return "path_align"; }
   bool prepare(const CriticContext& context, std::string& error) override;
   double score(const Trajectory& trajectory) override;
@@ -183,15 +182,14 @@ class GoalAlignCritic : public MapGridCritic
 {
 public:
   GoalAlignCritic(double scale, double forward_point_distance)
-    : MapGridCritic(scale, Target::LOCAL_GOAL, forward_point_distance, false),
-      forward_point_distance_(forward_point_distance)
-  {
-  }
+      : MapGridCritic(scale, Target::LOCAL_GOAL, forward_point_distance, false),
+        forward_point_distance_(forward_point_distance)
+  {}
   std::string name() const override { return "goal_align"; }
   bool prepare(const CriticContext& context, std::string& error) override;
 
 private:
-  double forward_point_distance_;  ///< [m]
+  double forward_point_distance_;   ///< [m]
   std::vector<Pose2D> front_plan_;  ///< the plan with its last pose moved forward
 };
 
@@ -205,9 +203,8 @@ class OscillationCritic : public TrajectoryCritic
 public:
   /// @param reset_dist [m] @param reset_angle [rad]
   OscillationCritic(double reset_dist, double reset_angle)
-    : TrajectoryCritic(1.0), reset_dist_(reset_dist), reset_angle_(reset_angle)
-  {
-  }
+      : TrajectoryCritic(1.0), reset_dist_(reset_dist), reset_angle_(reset_angle)
+  {}
   std::string name() const override { return "oscillation"; }
   bool prepare(const CriticContext&, std::string&) override { return true; }
   double score(const Trajectory& trajectory) override;

@@ -39,10 +39,10 @@ enum class LocalPlannerState
 struct LocalPlanResult
 {
   bool ok = false;
-  std::string error;       ///< e.g. "no valid trajectory: 60 samples, rejected by obstacle: 60"
+  std::string error;  ///< e.g. "no valid trajectory: 60 samples, rejected by obstacle: 60"
   LocalPlannerState state = LocalPlannerState::FOLLOWING;
-  Trajectory trajectory;   ///< the chosen trajectory (for the local_plan topic)
-  int samples = 0;         ///< trajectories simulated this cycle
+  Trajectory trajectory;  ///< the chosen trajectory (for the local_plan topic)
+  int samples = 0;        ///< trajectories simulated this cycle
 };
 
 /// @brief The DWA local planner (setPlan / computeVelocityCommands / isGoalReached).
@@ -114,8 +114,8 @@ private:
   TwirlingCritic twirling_critic_;
   std::vector<TrajectoryCritic*> critics_;
 
-  bool xy_latched_ = false;         ///< reached the goal position once (latch_xy_goal_tolerance)
-  bool rotating_to_goal_ = false;   ///< stopped at the goal position, now turning
+  bool xy_latched_ = false;        ///< reached the goal position once (latch_xy_goal_tolerance)
+  bool rotating_to_goal_ = false;  ///< stopped at the goal position, now turning
 
   // Reused per cycle (no allocation once sized).
   Trajectory candidate_;

@@ -28,7 +28,7 @@ namespace mbot_navigation
 /// @brief A goal as it arrives in a message: position [m] and orientation quaternion.
 struct GoalValues
 {
-  double x = 0.0, y = 0.0, z = 0.0;                ///< [m]
+  double x = 0.0, y = 0.0, z = 0.0;               ///< [m]
   double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  ///< orientation quaternion
 };
 
@@ -59,9 +59,8 @@ public:
   /// @param escape_radius a robot standing in an impassable cell (pushed against a wall, say)
   ///        counts as being in the nearest passable cell within this distance [m]
   explicit StaticGoalChecker(bool allow_unknown = true, double escape_radius = 0.5)
-    : allow_unknown_(allow_unknown), escape_radius_(escape_radius)
-  {
-  }
+      : allow_unknown_(allow_unknown), escape_radius_(escape_radius)
+  {}
 
   /// @brief Take a new static costmap (copied) and label its regions.
   void setCostmap(const Costmap2D& costmap);

@@ -64,16 +64,16 @@ private:
   void computeCaches();
 
   InflationLayerConfig config_;
-  double inscribed_radius_ = 0.0;  ///< [m]
-  double resolution_ = 0.0;        ///< [m/cell] of the grid the caches were built for
-  int cell_radius_ = 0;            ///< inflation radius in whole cells
+  double inscribed_radius_ = 0.0;    ///< [m]
+  double resolution_ = 0.0;          ///< [m/cell] of the grid the caches were built for
+  int cell_radius_ = 0;              ///< inflation radius in whole cells
   std::vector<uint8_t> cost_by_d2_;  ///< cost for squared distance d2 [cells^2], d2 <= cell_radius_^2
   // Reused buffers of the distance transform (no allocation per update once sized).
-  std::vector<int> col_dist_;   ///< pass 1: vertical distance to the nearest lethal cell [cells]
-  std::vector<int> d2_;         ///< pass 2: squared distance [cells^2]
-  std::vector<int> env_v_;      ///< lower envelope: parabola positions
-  std::vector<double> env_z_;   ///< lower envelope: boundaries
-  std::vector<int> row_f_;      ///< one row of squared column distances
+  std::vector<int> col_dist_;  ///< pass 1: vertical distance to the nearest lethal cell [cells]
+  std::vector<int> d2_;        ///< pass 2: squared distance [cells^2]
+  std::vector<int> env_v_;     ///< lower envelope: parabola positions
+  std::vector<double> env_z_;  ///< lower envelope: boundaries
+  std::vector<int> row_f_;     ///< one row of squared column distances
 };
 
 }  // namespace mbot_navigation

@@ -59,18 +59,18 @@ double footprintRadius(const XmlRpc::XmlRpcValue& footprint, const std::string& 
 /// @brief Everything the nav node reads from its parameters (see nav_node.h), read once at start.
 struct NavParams
 {
-  std::string robot;                 ///< namespace name, e.g. robot_0
-  std::string model = "mbot";        ///< robot model (mbot_description)
-  double footprint_radius = 0.15;    ///< of the model [m]
+  std::string robot;                     ///< namespace name, e.g. robot_0
+  std::string model = "mbot";            ///< robot model (mbot_description)
+  double footprint_radius = 0.15;        ///< of the model [m]
   std::string global_planner = "astar";  ///< ours: astar | ompl
   double controller_frequency = 20.0;    ///< [Hz]
   NavigatorConfig nav;
   bool clearing_rotation_allowed = true;
-  BackUpRecoveryConfig back_up;      ///< distance, speed (footprint filled by the node)
-  double model_min_vel_x = -0.2;     ///< the model's (how fast it may back up) [m/s]
-  std::vector<std::string> robots;   ///< teammates; empty: discover
+  BackUpRecoveryConfig back_up;     ///< distance, speed (footprint filled by the node)
+  double model_min_vel_x = -0.2;    ///< the model's (how fast it may back up) [m/s]
+  std::vector<std::string> robots;  ///< teammates; empty: discover
   std::string robots_source = "ground_truth";
-  double robots_timeout = 1.0;       ///< [s]
+  double robots_timeout = 1.0;  ///< [s]
   CostmapRosSettings global_costmap, local_costmap;
   GlobalPlannerParams planners;
   DwaConfig dwa;

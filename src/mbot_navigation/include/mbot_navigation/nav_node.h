@@ -165,9 +165,9 @@ private:
   double own_radius_ = 0.15;  ///< [m]
   std::string own_model_;
   std::map<std::string, double> model_radius_;  ///< cache: model name -> footprint radius [m]
-  double controller_patience_ = 15.0;  ///< also how long a missing robot pose is tolerated [s]
-  double transform_tolerance_ = 0.5;   ///< an older robot pose counts as missing [s] (global_costmap's)
-  double control_period_ = 0.05;       ///< 1 / controller_frequency [s]
+  double controller_patience_ = 15.0;           ///< also how long a missing robot pose is tolerated [s]
+  double transform_tolerance_ = 0.5;            ///< an older robot pose counts as missing [s] (global_costmap's)
+  double control_period_ = 0.05;                ///< 1 / controller_frequency [s]
 
   std::unique_ptr<tf2_ros::Buffer> tf_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;

@@ -37,11 +37,11 @@ namespace mbot_navigation
 /// @brief The state machine's settings, with move_base's parameter names.
 struct NavigatorConfig
 {
-  double planner_patience = 5.0;       ///< how long to try to plan before recovering [s]
-  double controller_patience = 15.0;   ///< how long without a valid command before recovering [s]
-  double planner_frequency = 0.0;      ///< periodic replanning [Hz]; 0: only when needed
-  double oscillation_timeout = 0.0;    ///< [s] recover when not moving oscillation_distance in it; 0: off
-  double oscillation_distance = 0.5;   ///< [m] this much motion counts as progress
+  double planner_patience = 5.0;      ///< how long to try to plan before recovering [s]
+  double controller_patience = 15.0;  ///< how long without a valid command before recovering [s]
+  double planner_frequency = 0.0;     ///< periodic replanning [Hz]; 0: only when needed
+  double oscillation_timeout = 0.0;   ///< [s] recover when not moving oscillation_distance in it; 0: off
+  double oscillation_distance = 0.5;  ///< [m] this much motion counts as progress
   bool recovery_behavior_enabled = true;
   /// NO_INFORMATION cells are passable (the global planner's allow_unknown): the blocked-plan test
   /// must agree with the planner, or it would replan forever.
@@ -161,8 +161,8 @@ private:
   double last_progress_time_ = 0.0;  ///< [s] the robot last moved oscillation_distance
   Pose2D progress_pose_;             ///< where it was then
   bool progress_pose_set_ = false;
-  size_t recovery_index_ = 0;        ///< next recovery to run
-  std::vector<std::string> tried_;   ///< recoveries run since the last progress
+  size_t recovery_index_ = 0;       ///< next recovery to run
+  std::vector<std::string> tried_;  ///< recoveries run since the last progress
   std::string last_error_;
 };
 

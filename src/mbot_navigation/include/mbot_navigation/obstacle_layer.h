@@ -21,9 +21,9 @@ namespace mbot_navigation
 /// @brief ObstacleLayer settings, with move_base's (costmap_2d's) parameter names.
 struct ObstacleLayerConfig
 {
-  double obstacle_range = 2.5;        ///< mark hits no further than this from the sensor [m]
-  double raytrace_range = 3.0;        ///< clear free space no further than this [m]
-  bool track_unknown_space = false;   ///< never-seen cells: NO_INFORMATION (true) or FREE (false)
+  double obstacle_range = 2.5;             ///< mark hits no further than this from the sensor [m]
+  double raytrace_range = 3.0;             ///< clear free space no further than this [m]
+  bool track_unknown_space = false;        ///< never-seen cells: NO_INFORMATION (true) or FREE (false)
   bool footprint_clearing_enabled = true;  ///< clear the cells under the robot (robot_radius)
 };
 
@@ -37,9 +37,9 @@ struct ScanBeam
 /// @brief A laser scan already transformed into the costmap frame.
 struct ScanObservation
 {
-  double origin_x = 0.0;  ///< sensor position in the costmap frame [m]
-  double origin_y = 0.0;  ///< [m]
-  double range_min = 0.0;                                       ///< [m] (LaserScan.range_min)
+  double origin_x = 0.0;                                       ///< sensor position in the costmap frame [m]
+  double origin_y = 0.0;                                       ///< [m]
+  double range_min = 0.0;                                      ///< [m] (LaserScan.range_min)
   double range_max = std::numeric_limits<double>::infinity();  ///< [m] (LaserScan.range_max)
   std::vector<ScanBeam> beams;
 

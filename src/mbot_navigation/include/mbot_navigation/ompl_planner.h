@@ -43,17 +43,17 @@ namespace mbot_navigation
 struct OmplConfig
 {
   std::string planner = "rrtconnect";  ///< "rrtconnect" (fast, repeatable), "rrtstar" or "prmstar"
-  double time_limit = 0.5;          ///< planning time [s]; RRT* and PRM* use all of it to
-                                    ///< improve the path, RRT-Connect stops at its first path
-  double simplify_time_limit = 0.2; ///< at most this long [s] for the cost-aware simplification
-                                    ///< (it usually converges much sooner)
-  double cost_weight = 4.0;         ///< a metre through a cell of cost c counts as
-                                    ///< 1 + cost_weight * c / 252 m; 0: only the length matters.
-                                    ///< 4 is A*'s default (neutral_cost 50, cost_factor 0.8)
-  unsigned seed = 42;               ///< OMPL's random seed (> 0), set before every plan
-  double path_resolution = 0.0;     ///< spacing of the returned poses [m]; 0: the costmap's
-                                    ///< resolution
-  bool simplify = true;             ///< improve the planner's path (shortcuts and perturbations)
+  double time_limit = 0.5;             ///< planning time [s]; RRT* and PRM* use all of it to
+                                       ///< improve the path, RRT-Connect stops at its first path
+  double simplify_time_limit = 0.2;    ///< at most this long [s] for the cost-aware simplification
+                                       ///< (it usually converges much sooner)
+  double cost_weight = 4.0;            ///< a metre through a cell of cost c counts as
+                                       ///< 1 + cost_weight * c / 252 m; 0: only the length matters.
+                                       ///< 4 is A*'s default (neutral_cost 50, cost_factor 0.8)
+  unsigned seed = 42;                  ///< OMPL's random seed (> 0), set before every plan
+  double path_resolution = 0.0;        ///< spacing of the returned poses [m]; 0: the costmap's
+                                       ///< resolution
+  bool simplify = true;                ///< improve the planner's path (shortcuts and perturbations)
 };
 
 /// @brief GlobalPlanner on OMPL; see the file comment.

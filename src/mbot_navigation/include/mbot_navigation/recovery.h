@@ -21,9 +21,9 @@ namespace mbot_navigation
 /// @brief What a recovery sees in one control cycle (costmap frame).
 struct RecoveryInput
 {
-  double now = 0.0;       ///< [s]
-  Pose2D pose;            ///< the robot [m, m, rad]
-  Twist2D velocity;       ///< measured, robot frame [m/s, m/s, rad/s]
+  double now = 0.0;                          ///< [s]
+  Pose2D pose;                               ///< the robot [m, m, rad]
+  Twist2D velocity;                          ///< measured, robot frame [m/s, m/s, rad/s]
   const Costmap2D* local_costmap = nullptr;  ///< the local costmap, updated this cycle
 };
 
@@ -68,12 +68,12 @@ private:
 /// @brief RotateRecovery settings.
 struct RotateRecoveryConfig
 {
-  double max_vel_theta = 1.0;   ///< [rad/s]
-  double acc_lim_theta = 3.2;   ///< [rad/s^2]
-  double min_vel_theta = 0.4;   ///< slowest turn that still moves the robot [rad/s]
+  double max_vel_theta = 1.0;    ///< [rad/s]
+  double acc_lim_theta = 3.2;    ///< [rad/s^2]
+  double min_vel_theta = 0.4;    ///< slowest turn that still moves the robot [rad/s]
   double control_period = 0.05;  ///< [s] 1 / controller_frequency
-  double tolerance = 0.1;       ///< stop this short of a full turn [rad]
-  double timeout = 20.0;        ///< give up after this long [s]
+  double tolerance = 0.1;        ///< stop this short of a full turn [rad]
+  double timeout = 20.0;         ///< give up after this long [s]
 };
 
 /**
@@ -100,10 +100,10 @@ private:
 /// @brief BackUpRecovery settings.
 struct BackUpRecoveryConfig
 {
-  double distance = 0.3;          ///< how far to back up [m]
-  double speed = 0.1;             ///< backwards speed [m/s] (> 0)
+  double distance = 0.3;           ///< how far to back up [m]
+  double speed = 0.1;              ///< backwards speed [m/s] (> 0)
   double footprint_radius = 0.15;  ///< the robot's circle [m]
-  double timeout = 10.0;          ///< give up after this long [s]
+  double timeout = 10.0;           ///< give up after this long [s]
 };
 
 /**

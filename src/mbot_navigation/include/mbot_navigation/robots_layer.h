@@ -30,12 +30,12 @@ struct RobotsLayerConfig
 /// @brief What the fleet reports about one teammate.
 struct TeammateState
 {
-  std::string name;      ///< for messages, e.g. "robot_1"
-  Pose2D pose;           ///< in the costmap frame [m, m, rad]
-  double radius = 0.2;   ///< footprint radius [m]
-  double vx = 0.0;       ///< forward velocity, body frame [m/s]
-  double vy = 0.0;       ///< sideways velocity, body frame [m/s] (omni robots; 0 for diff drive)
-  double wz = 0.0;       ///< yaw rate [rad/s]
+  std::string name;     ///< for messages, e.g. "robot_1"
+  Pose2D pose;          ///< in the costmap frame [m, m, rad]
+  double radius = 0.2;  ///< footprint radius [m]
+  double vx = 0.0;      ///< forward velocity, body frame [m/s]
+  double vy = 0.0;      ///< sideways velocity, body frame [m/s] (omni robots; 0 for diff drive)
+  double wz = 0.0;      ///< yaw rate [rad/s]
 };
 
 /// @brief Draws teammates (footprint LETHAL, predicted sweep `prediction_cost`) at every update.
@@ -60,8 +60,7 @@ public:
 
 private:
   /// @brief Raise the cells whose centre is within `radius` [m] of (x, y) [m] to `c` (max).
-  static void drawDisc(Costmap2D& master, const CellWindow& window, double x, double y, double radius,
-                       uint8_t c);
+  static void drawDisc(Costmap2D& master, const CellWindow& window, double x, double y, double radius, uint8_t c);
 
   RobotsLayerConfig config_;
   std::vector<TeammateState> teammates_;

@@ -40,8 +40,7 @@ public:
    *        corner of cell (0, 0) [m] (rotation is ignored, as costmap_2d does)
    * @param data width * height occupancy values, row-major, row 0 at origin_y
    */
-  void setMap(unsigned width, unsigned height, double resolution, double origin_x, double origin_y,
-              const int8_t* data);
+  void setMap(unsigned width, unsigned height, double resolution, double origin_x, double origin_y, const int8_t* data);
 
   /// @brief The cost that an occupancy value becomes (costmap_2d's StaticLayer::interpretValue).
   uint8_t interpretValue(int8_t value) const;
@@ -55,7 +54,7 @@ public:
 
 private:
   StaticLayerConfig config_;
-  Costmap2D map_;                  ///< the map as costs
+  Costmap2D map_;  ///< the map as costs
   bool has_map_ = false;
   bool has_updated_data_ = false;  ///< a new map arrived since the last update
 };

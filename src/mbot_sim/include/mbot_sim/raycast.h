@@ -47,8 +47,7 @@ enum class WallMethod
 ///        Beam i points along spec.yaw + spec.min_angle + i * spec.angle_increment.
 /// @throws std::invalid_argument for beams < 0, range_max <= 0 or a yaw or angle that is not
 ///         finite
-void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec& spec,
-              std::vector<float>& ranges);
+void castScan(const GridRaycaster& grid, const ShapeSet& shapes, const ScanSpec& spec, std::vector<float>& ranges);
 
 /// @brief Casts rays against the static occupancy grid (the map walls).
 ///
@@ -61,8 +60,8 @@ public:
   /// @param occupied size_x * size_y cells, row-major, row 0 at origin_y (non-zero = occupied)
   /// @param resolution cell side [m]; origin_x, origin_y: lower-left corner of cell (0, 0) [m]
   /// @throws std::invalid_argument when occupied.size() != size_x * size_y or resolution <= 0
-  GridRaycaster(std::vector<uint8_t> occupied, unsigned size_x, unsigned size_y, double resolution,
-                double origin_x, double origin_y);
+  GridRaycaster(std::vector<uint8_t> occupied, unsigned size_x, unsigned size_y, double resolution, double origin_x,
+                double origin_y);
 
   /// @brief Distance [m] along heading `theta` [rad] from (x, y) [m] to the first occupied cell,
   ///        or `max_range` when there is none closer. Outside the grid counts as free.
@@ -77,16 +76,15 @@ public:
   ///        gets what castDirection() would return. Faster per ray than n single casts: the
   ///        rays are traced interleaved (see raycast.cpp).
   /// @throws std::invalid_argument for a direction that is not finite
-  void castFan(double x, double y, const double* dir_x, const double* dir_y, int n,
-               double max_range, double* ranges) const;
+  void castFan(double x, double y, const double* dir_x, const double* dir_y, int n, double max_range,
+               double* ranges) const;
 
   /// @brief As castFan() for the beams of a scan: beam i points along the world angle
   ///        first_angle + i * increment [rad] and (dir_x[i], dir_y[i]) is its unit vector.
   ///        The angles let the sweep compute which beams a wall face covers directly.
   /// @throws std::invalid_argument for a direction that is not finite
-  void castScanWalls(double x, double y, const double* dir_x, const double* dir_y,
-                     double first_angle, double increment, int n, double max_range,
-                     double* ranges, WallMethod method = WallMethod::kAuto) const;
+  void castScanWalls(double x, double y, const double* dir_x, const double* dir_y, double first_angle, double increment,
+                     int n, double max_range, double* ranges, WallMethod method = WallMethod::kAuto) const;
 
   /// @brief Number of wall faces (merged runs of cell edges between a free and an occupied
   ///        cell) the sweep works with.
@@ -126,9 +124,8 @@ private:
   void computeClearance();
   void extractWallFaces();
   /// The angular sweep of castScanWalls(); false (nothing done) where the walk is to be used.
-  bool sweepWalls(double x, double y, const double* dir_x, const double* dir_y,
-                  double first_angle, double increment, int n, double max_range, double* ranges,
-                  WallMethod method) const;
+  bool sweepWalls(double x, double y, const double* dir_x, const double* dir_y, double first_angle, double increment,
+                  int n, double max_range, double* ranges, WallMethod method) const;
 
   unsigned size_x_ = 0;
   unsigned size_y_ = 0;
@@ -195,8 +192,7 @@ public:
   size_t size() const;
 
 private:
-  friend void castScan(const GridRaycaster&, const ShapeSet&, const ScanSpec&,
-                       std::vector<float>&);
+  friend void castScan(const GridRaycaster&, const ShapeSet&, const ScanSpec&, std::vector<float>&);
 
   /// A box with its rotation precomputed once per rebuild instead of once per beam.
   struct PreparedBox
@@ -226,9 +222,9 @@ private:
 /// @brief One laser scan request: sensor pose in the world and the beam layout.
 struct ScanSpec
 {
-  double x = 0.0;        ///< sensor position [m]
+  double x = 0.0;  ///< sensor position [m]
   double y = 0.0;
-  double yaw = 0.0;      ///< sensor heading [rad]
+  double yaw = 0.0;              ///< sensor heading [rad]
   double min_angle = 0.0;        ///< angle of beam 0 relative to the sensor heading [rad]
   double angle_increment = 0.0;  ///< [rad]
   int beams = 0;

@@ -45,23 +45,23 @@ public:
 /// @brief Parameters of stage_node, read once at startup.
 struct StageParams
 {
-  std::string world;               ///< ~world: a world name (maps/NAME.world.yaml) or a path
-  std::string maps_dir;            ///< ~maps_dir: where bare world names are looked up first
+  std::string world;     ///< ~world: a world name (maps/NAME.world.yaml) or a path
+  std::string maps_dir;  ///< ~maps_dir: where bare world names are looked up first
   bool has_real_time_factor = false;
-  double real_time_factor = 1.0;   ///< ~real_time_factor: overrides the world file's when set
+  double real_time_factor = 1.0;  ///< ~real_time_factor: overrides the world file's when set
   bool has_seed = false;
-  int seed = 0;                    ///< ~seed: overrides the world file's when set
-  double watchdog_timeout = 0.2;   ///< ~base_watchdog_timeout [s sim time]
-  double marker_rate = 10.0;       ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
-  bool lockstep = false;           ///< ~lockstep: hold sim time at period boundaries for the controllers
-  double lockstep_period = 0.05;   ///< ~lockstep_period: distance of the boundaries [s sim time]
-  double lockstep_active_timeout = 0.5;  ///< ~lockstep_active_timeout: a robot is driven while its
-                                         ///< last cmd_vel is at most this old [s sim time]
-  double lockstep_wall_timeout = 2.0;    ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
+  int seed = 0;                            ///< ~seed: overrides the world file's when set
+  double watchdog_timeout = 0.2;           ///< ~base_watchdog_timeout [s sim time]
+  double marker_rate = 10.0;               ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+  bool lockstep = false;                   ///< ~lockstep: hold sim time at period boundaries for the controllers
+  double lockstep_period = 0.05;           ///< ~lockstep_period: distance of the boundaries [s sim time]
+  double lockstep_active_timeout = 0.5;    ///< ~lockstep_active_timeout: a robot is driven while its
+                                           ///< last cmd_vel is at most this old [s sim time]
+  double lockstep_wall_timeout = 2.0;      ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
   double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: each robot's localization
                                            ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
-  double lockstep_pacer_lag = 0.3;  ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
-                                    ///< /lockstep/heartbeat) may lag it this much [s sim]
+  double lockstep_pacer_lag = 0.3;         ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
+                                           ///< /lockstep/heartbeat) may lag it this much [s sim]
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
@@ -99,12 +99,12 @@ private:
     sensor_msgs::LaserScan scan_msg;
     sensor_msgs::JointState joint_msg;
     geometry_msgs::TransformStamped odom_tf;
-    double last_cmd_time = -1e9;  ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
-    long cmd_boundary = -1;       ///< boundary_count_ when the last cmd_vel arrived
-    bool cmd_unused = false;      ///< lockstep: the last cmd_vel has not released a boundary yet
-    double localization_stamp = -1e9;  ///< lockstep: newest stamp of a transform to <ns>/odom [s]
-    bool localization_ignored = false; ///< lockstep: its localization timed out; not waited for
-                                       ///< until it has caught up
+    double last_cmd_time = -1e9;        ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
+    long cmd_boundary = -1;             ///< boundary_count_ when the last cmd_vel arrived
+    bool cmd_unused = false;            ///< lockstep: the last cmd_vel has not released a boundary yet
+    double localization_stamp = -1e9;   ///< lockstep: newest stamp of a transform to <ns>/odom [s]
+    bool localization_ignored = false;  ///< lockstep: its localization timed out; not waited for
+                                        ///< until it has caught up
   };
 
   const mbot_description::RobotModel& model(const std::string& name);
@@ -141,7 +141,7 @@ private:
 
   std::vector<std::unique_ptr<RobotIo>> io_;  ///< by robot id; nullptr for removed robots
   ros::Publisher clock_pub_, contact_pub_, marker_pub_;
-  ros::Subscriber tf_sub_;  ///< lockstep only: the robots' localization transforms
+  ros::Subscriber tf_sub_;         ///< lockstep only: the robots' localization transforms
   ros::Subscriber heartbeat_sub_;  ///< lockstep only: nodes that pace sim time (the fleet coordinator)
   std::vector<ros::ServiceServer> services_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
@@ -150,8 +150,8 @@ private:
   ros::WallTime next_marker_wall_;
 
   // lockstep (see waitForControllers())
-  long boundary_count_ = 0;           ///< boundaries published so far
-  double next_boundary_ = 0.0;        ///< sim time of the next boundary [s]
+  long boundary_count_ = 0;             ///< boundaries published so far
+  double next_boundary_ = 0.0;          ///< sim time of the next boundary [s]
   bool boundary_wait_pending_ = false;  ///< a boundary was published and not yet waited at
   /// A node that sim time waits for besides the controllers: its newest heartbeat stamp [s sim],
   /// and whether it timed out (not waited for until it has caught up by itself).
@@ -161,7 +161,7 @@ private:
     bool ignored = false;
   };
   std::map<std::string, Pacer> pacers_;  ///< by node name (the heartbeat's frame_id)
-  long lockstep_timeouts_ = 0;        ///< wall timeouts since the last warning
+  long lockstep_timeouts_ = 0;           ///< wall timeouts since the last warning
   ros::WallTime last_lockstep_warning_;
 };
 

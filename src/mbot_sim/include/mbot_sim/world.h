@@ -36,22 +36,22 @@ namespace mbot_sim
 {
 // The plain types of the world are mbot_common's: geometry (Pose2D {x, y, theta}, Twist2D
 // {vx, vy, wz}), the map (map_io.h) and the world file's structs and reader (world_file.h).
-using mbot_common::Point2D;
-using mbot_common::Pose2D;
-using mbot_common::Twist2D;
-using mbot_common::loadMap;
-using mbot_common::MapError;
-using mbot_common::OccupancyMap;
 using mbot_common::checkFaults;
 using mbot_common::checkName;
 using mbot_common::FaultConfig;
+using mbot_common::loadMap;
 using mbot_common::loadWorldConfig;
+using mbot_common::MapError;
 using mbot_common::MovingObstacleConfig;
 using mbot_common::NoiseConfig;
 using mbot_common::ObstacleConfig;
+using mbot_common::OccupancyMap;
+using mbot_common::Point2D;
+using mbot_common::Pose2D;
 using mbot_common::RobotConfig;
 using mbot_common::RobotFaultConfig;
 using mbot_common::ShapeConfig;
+using mbot_common::Twist2D;
 using mbot_common::WorldConfig;
 using mbot_common::WorldConfigError;
 
@@ -83,9 +83,9 @@ struct GroundTruthSample
 /// @brief Wheel joint angles, in the order of RobotModel::wheel_joints.
 struct JointStateSample
 {
-  double stamp = 0.0;             ///< [s]
-  std::vector<double> position;   ///< [rad]
-  std::vector<double> velocity;   ///< [rad/s]
+  double stamp = 0.0;            ///< [s]
+  std::vector<double> position;  ///< [rad]
+  std::vector<double> velocity;  ///< [rad/s]
 };
 
 /// @brief One laser scan; beam i is at angle min_angle + i * angleIncrement() in the laser frame.
@@ -131,10 +131,10 @@ public:
 /// @brief Settings of a World that do not come from the bodies.
 struct WorldSettings
 {
-  double physics_step = 0.01;      ///< [s]
-  unsigned seed = 0;               ///< robot i draws its noise from std::mt19937(seed + i)
-  NoiseConfig noise;               ///< sensor noise of every robot
-  double watchdog_timeout = 0.2;   ///< [s] a robot with no command for this long stops
+  double physics_step = 0.01;     ///< [s]
+  unsigned seed = 0;              ///< robot i draws its noise from std::mt19937(seed + i)
+  NoiseConfig noise;              ///< sensor noise of every robot
+  double watchdog_timeout = 0.2;  ///< [s] a robot with no command for this long stops
   /// [m] robots collide this much before their footprints touch, so that a footprint never
   /// enters a wall even in the step in which a contact begins (a fast robot moves 5 mm a step).
   double contact_margin = 0.01;
@@ -194,8 +194,8 @@ public:
   void setListener(SensorListener* listener);
   /// @brief Advance sim time by one physics step; then sensors that are due measure.
   void step();
-  double time() const;          ///< sim time [s]
-  double physicsStep() const;   ///< [s]
+  double time() const;         ///< sim time [s]
+  double physicsStep() const;  ///< [s]
 
   // ---- queries -----------------------------------------------------------------------------
   /// @return the robot's id, or -1 when there is no robot of that name
@@ -205,9 +205,9 @@ public:
   size_t robotCount() const;
   const std::string& robotName(int robot) const;
   const mbot_description::RobotModel& robotModel(int robot) const;
-  Pose2D groundTruth(int robot) const;    ///< true pose in the map frame
-  Twist2D velocity(int robot) const;      ///< true velocity in the robot frame
-  Pose2D odometry(int robot) const;       ///< current odometry pose (odom frame)
+  Pose2D groundTruth(int robot) const;  ///< true pose in the map frame
+  Twist2D velocity(int robot) const;    ///< true velocity in the robot frame
+  Pose2D odometry(int robot) const;     ///< current odometry pose (odom frame)
   const FaultConfig& faults(int robot) const;
   /// @brief True when a circle of `radius` [m] at (x, y) inside the map overlaps no wall,
   ///        obstacle or robot.
