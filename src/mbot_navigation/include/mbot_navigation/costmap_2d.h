@@ -1,6 +1,6 @@
 /**
  * @file costmap_2d.h
- * @brief A 2D grid of navigation costs, free of ROS types (STYLE.md 1, 3).
+ * @brief A 2D grid of navigation costs, free of ROS types.
  *
  * Cell (mx, my) is stored at index my * size_x + mx; cell (0, 0) is the one whose lower-left
  * corner is the origin. Costs follow costmap_2d's cost_values.h.

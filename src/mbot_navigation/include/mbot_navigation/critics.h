@@ -1,6 +1,6 @@
 /**
  * @file critics.h
- * @brief The DWA critics: each scores a simulated trajectory (STYLE.md 4). Free of ROS types.
+ * @brief The DWA critics: each scores a simulated trajectory. Free of ROS types.
  *
  * Model: base_local_planner/trajectory_cost_function.h and its implementations
  * (obstacle_cost_function, map_grid_cost_function, oscillation_cost_function,

@@ -1,6 +1,6 @@
 /**
  * @file dwa_planner.h
- * @brief The DWA local planner: a trajectory generator plus weighted critics (STYLE.md 2, 4),
+ * @brief The DWA local planner: a trajectory generator plus weighted critics,
  *        with nav_core's local planner interface, free of ROS types.
  *
  * Model: ros-planning/navigation dwa_local_planner/dwa_planner.h (sampling and scoring) and

@@ -1,6 +1,6 @@
 /**
  * @file goal_checks.h
- * @brief Why a navigation goal cannot be accepted, free of ROS types (STYLE.md 1).
+ * @brief Why a navigation goal cannot be accepted, free of ROS types.
  *
  * The nav node rejects a bad goal at once, with a status text that says why, instead of letting
  * the planner fail for planner_patience seconds:

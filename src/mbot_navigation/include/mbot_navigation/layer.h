@@ -1,6 +1,6 @@
 /**
  * @file layer.h
- * @brief One layer of a layered costmap (costmap_2d's Layer, without ROS types; STYLE.md 3).
+ * @brief One layer of a layered costmap (costmap_2d's Layer, without ROS types).
  *
  * An update of the LayeredCostmap runs in two passes over its layers, in the order they were
  * added: updateBounds() lets every layer grow the dirty window (world coordinates [m]) by the

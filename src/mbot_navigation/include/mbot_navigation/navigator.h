@@ -1,6 +1,6 @@
 /**
  * @file navigator.h
- * @brief move_base's state machine (plan, control, recover), free of ROS types (STYLE.md 1).
+ * @brief move_base's state machine (plan, control, recover), free of ROS types.
  *
  * The nav node feeds it one control cycle at a time (the robot's pose and velocity and the two
  * updated costmaps) and publishes what it returns; everything else of move_base's behaviour is

@@ -15,7 +15,7 @@
 namespace mbot_navigation
 {
 /// @brief The settings of every global planner; the factory passes the chosen one's part on.
-///        Parameters are read at the edge (the nav node) into these structs (STYLE.md 7).
+///        Parameters are read at the edge (the nav node) into these structs.
 struct GlobalPlannerParams
 {
   AStarConfig astar;  ///< for "astar" (AStarPlanner)

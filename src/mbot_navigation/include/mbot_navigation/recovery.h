@@ -1,7 +1,7 @@
 /**
  * @file recovery.h
  * @brief Recovery behaviours of the nav node (move_base's clear_costmap_recovery,
- *        rotate_recovery and a back-up), free of ROS types (STYLE.md 1, 2).
+ *        rotate_recovery and a back-up), free of ROS types.
  *
  * move_base runs a recovery as one blocking call that publishes velocities itself. Here a
  * recovery is stepped by the control loop instead, one cycle at a time, so that the node keeps

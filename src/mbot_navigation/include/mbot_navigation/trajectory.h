@@ -1,7 +1,7 @@
 /**
  * @file trajectory.h
  * @brief The vocabulary of the DWA local planner: a velocity, a simulated trajectory and the
- *        planner's parameters (DwaConfig). Free of ROS types (STYLE.md 1).
+ *        planner's parameters (DwaConfig). Free of ROS types.
  *
  * Model: ros-planning/navigation base_local_planner/trajectory.h and
  * dwa_local_planner/cfg/DWAPlanner.cfg (parameter names and defaults are theirs).
