@@ -208,7 +208,7 @@ class FollowerController(object):
         started += time.time() - lookup_started  # waiting for tf is not computing: not in cycle_time
         self.trail.add(leader_map.x, leader_map.y)
         slot = self._slot_relative_to(a, reference)
-        target, mode = self._target(slot, pose, ref_map)
+        target, mode = self._target(slot, pose, ref_map, math.hypot(*a.slots[self.robot]))
         neighbours = self._neighbours(a, now) if self.params["controller"] == "consensus" else []
         twist = self.leader_twist if mode == "slot" else Twist2D(self.leader_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
@@ -240,9 +240,11 @@ class FollowerController(object):
         rx, ry = a.slots[reference]
         return sx - rx, sy - ry
 
-    def _target(self, slot, pose, ref_map):
+    def _target(self, slot, pose, ref_map, behind_leader):
         """(target in the reference robot's frame, mode): the slot, or the trail point when the
-        slot or the way to it is blocked."""
+        slot or the way to it is blocked. The trail is the leader's: in a chain the point is
+        `behind_leader` (the slot's distance from the leader) back on it, not the distance from
+        the robot ahead."""
         slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
         me_map = compose(ref_map, pose)
         blocked = False
@@ -253,8 +255,7 @@ class FollowerController(object):
             blocked = self._scan_blocks(pose, slot)
         if not blocked or len(self.trail) < 2:
             return slot, "slot"
-        tx, ty = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"],
-                                          math.hypot(slot[0], slot[1]))
+        tx, ty = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
         t = relative(ref_map, Pose2D(tx, ty, 0.0))
         return (t.x, t.y), "trail"
 
