@@ -196,8 +196,6 @@ class FollowerController(object):
             pose, stamp = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % self.robot,
                                       now, age, self.params["pose_wait"])
             ref_map, _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % reference, now, age)
-            leader_map = ref_map if reference == a.leader else lookup_pose(
-                self.tf_buffer, "map", "%s/base_link" % a.leader, now, age)[0]
         except StalePose as error:
             self.lookup_failures += 1
             rospy.logwarn_throttle(2.0, "%s: no current pose, holding still: %s" % (rospy.get_name(), error))
@@ -206,7 +204,7 @@ class FollowerController(object):
             return
 
         started += time.time() - lookup_started  # waiting for tf is not computing: not in cycle_time
-        self.trail.add(leader_map.x, leader_map.y)
+        self._record_trail(a, reference, ref_map, now)
         slot = self._slot_relative_to(a, reference)
         target, mode = self._target(slot, pose, ref_map, math.hypot(*a.slots[self.robot]))
         neighbours = self._neighbours(a, now) if self.params["controller"] == "consensus" else []
@@ -227,6 +225,19 @@ class FollowerController(object):
         self._was_driving = True
         err = (slot[0] - pose.x, slot[1] - pose.y)
         self._publish_state(now, mode, started, stamp, err, -pose.theta, cmd)
+
+    def _record_trail(self, a, reference, ref_map, now):
+        """Add the leader's map position to its trail. In a chain the leader is not the robot
+        this follower tracks: a stale leader pose only skips this point of the trail (it must
+        not hold the robot still)."""
+        leader_map = ref_map
+        if reference != a.leader:
+            try:
+                leader_map = lookup_pose(self.tf_buffer, "map", "%s/base_link" % a.leader, now,
+                                         self.params["max_pose_age"])[0]
+            except StalePose:
+                return
+        self.trail.add(leader_map.x, leader_map.y)
 
     def _rank(self, a, slot):
         """How many follower slots lie farther from the leader than this robot's (GiveWay)."""
