@@ -13,7 +13,6 @@ map frame, so robot (x, y) belongs at left + (x - x0) * s, bottom - (y - y0) * s
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import time
 
@@ -22,6 +21,7 @@ import pytest
 import yaml
 
 from mbot_bringup.fleet_rviz import write_fleet_view
+from mbot_bringup.scenario_runner import free_port
 from mbot_bringup.screenshot import looks_rendered
 from mbot_common.paths import resolve_world
 from mbot_common.world import load_world
@@ -35,14 +35,6 @@ MAP_ALPHA = 0.7            # fleet.rviz Map "Alpha"
 MARKER_ALPHA = 0.9         # stage_node's robot markers
 
 pytestmark = pytest.mark.skipif(bool(MISSING), reason="not installed: %s" % ", ".join(MISSING))
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def marker_rgb(index):
