@@ -34,6 +34,7 @@
 
 #include "mbot_common/strict_yaml.h"
 #include "mbot_description/robot_model.h"
+#include "mbot_navigation/dwa_model_limits.h"
 #include "mbot_navigation/dwa_planner.h"
 #include "mbot_navigation/inflation_layer.h"
 
@@ -84,17 +85,7 @@ DwaConfig shippedConfig(const std::string& path, const std::string& description_
 {
   const mbot_description::RobotModel model = mbot_description::loadRobotModel(description_dir, model_name);
   DwaConfig c;
-  const mbot_description::Limits& lim = model.limits;
-  c.max_vel_x = lim.max_vel_x;
-  c.min_vel_x = lim.min_vel_x;
-  c.max_vel_y = lim.max_vel_y;
-  c.min_vel_y = -lim.max_vel_y;
-  c.max_vel_trans = std::max(lim.max_vel_x, lim.max_vel_y);
-  c.max_vel_theta = lim.max_vel_theta;
-  c.min_vel_theta = std::min(c.min_vel_theta, lim.max_vel_theta);
-  c.acc_lim_x = lim.acc_lim_x;
-  c.acc_lim_y = lim.acc_lim_y;
-  c.acc_lim_theta = lim.acc_lim_theta;
+  applyModelLimits(model.limits, c);
   c.footprint_radius = model.footprint_radius;
 
   const mbot_common::StrictYaml<> yaml(path);

@@ -1,3 +1,4 @@
+#include "mbot_navigation/dwa_model_limits.h"
 #include "mbot_navigation/move_base_params.h"
 
 #include <algorithm>
@@ -68,17 +69,7 @@ DwaConfig readDwaConfig(DwaParams& p, const mbot_description::RobotModel& model,
                         double controller_frequency)
 {
   DwaConfig c;
-  const mbot_description::Limits& lim = model.limits;
-  c.max_vel_x = lim.max_vel_x;
-  c.min_vel_x = lim.min_vel_x;
-  c.max_vel_y = lim.max_vel_y;
-  c.min_vel_y = -lim.max_vel_y;
-  c.max_vel_trans = std::max(lim.max_vel_x, lim.max_vel_y);
-  c.max_vel_theta = lim.max_vel_theta;
-  c.min_vel_theta = std::min(c.min_vel_theta, lim.max_vel_theta);
-  c.acc_lim_x = lim.acc_lim_x;
-  c.acc_lim_y = lim.acc_lim_y;
-  c.acc_lim_theta = lim.acc_lim_theta;
+  applyModelLimits(model.limits, c);
 
   c.max_vel_trans = p.getDouble("max_vel_trans", c.max_vel_trans, "max_trans_vel");
   c.min_vel_trans = p.getDouble("min_vel_trans", c.min_vel_trans, "min_trans_vel");
