@@ -3,7 +3,8 @@
 
 Usage: test_summary.py DIR [DIR ...]
 
-Prints one line per result file with failures, then the totals as the plain closing line
+Prints one line per result file with failures, then the end of each failure's message (so that
+a CI log, which keeps the tail, shows why), then the totals as the plain closing line
 `N passed, N failed, N skipped`. Exit status 1 when anything failed or no test ran.
 rostest writes a `rostest-*.xml` file with one case per test node (did it run and pass) and the
 node's own `rosunit-*.xml` with its test cases. The node's cases are counted; the rostest case
@@ -24,19 +25,25 @@ def result_files(dirs):
 
 
 def count(path):
-    """Return (passed, failed, skipped, failed_case_names) for one JUnit file."""
+    """Return (passed, failed, skipped, failures) for one JUnit file.
+
+    failures is a list of (case name, message text).
+    """
     try:
         tree = ET.parse(path)
     except ET.ParseError as err:
-        return 0, 1, 0, ["%s: unreadable result file (%s)" % (path, err)]
+        return 0, 1, 0, [(path, "unreadable result file (%s)" % err)]
     passed = failed = skipped = 0
     failures = []
     only_failures = os.path.basename(path).startswith("rostest-")
     for case in tree.iter("testcase"):
         name = "%s.%s" % (case.get("classname", ""), case.get("name", ""))
-        if case.find("failure") is not None or case.find("error") is not None:
+        bad = case.find("failure")
+        if bad is None:
+            bad = case.find("error")
+        if bad is not None:
             failed += 1
-            failures.append(name)
+            failures.append((name, (bad.get("message") or "") + "\n" + (bad.text or "")))
         elif only_failures:
             continue
         elif case.find("skipped") is not None:
@@ -47,12 +54,18 @@ def count(path):
     for suite in tree.iter("testsuite"):
         if not list(suite.iter("testcase")) and int(suite.get("errors", 0) or 0) > 0:
             failed += 1
-            failures.append("%s (suite error)" % suite.get("name"))
+            failures.append(("%s (suite error)" % suite.get("name"), ""))
     return passed, failed, skipped, failures
+
+
+def message_tail(text, lines=8):
+    kept = [line.rstrip() for line in text.strip().splitlines() if line.strip()]
+    return kept[-lines:]
 
 
 def main(dirs):
     totals = [0, 0, 0]
+    details = []
     for path in result_files(dirs):
         p, f, s, failures = count(path)
         totals[0] += p
@@ -60,8 +73,14 @@ def main(dirs):
         totals[2] += s
         rel = os.path.relpath(path)
         print("  %-70s %4d passed %3d failed %3d skipped" % (rel[-70:], p, f, s))
-        for name in failures:
+        for name, message in failures:
             print("      FAILED: %s" % name)
+            details.append((name, message))
+    for name, message in details:
+        print()
+        print("FAILED %s:" % name)
+        for line in message_tail(message):
+            print("    " + line[:200])
     print()
     print("%d passed, %d failed, %d skipped" % tuple(totals))
     if totals[0] + totals[1] == 0:

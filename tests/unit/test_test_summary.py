@@ -70,3 +70,20 @@ def test_no_results_is_an_error(tmp_path):
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
     assert proc.returncode == 1
     assert "no test ran" in proc.stderr
+
+
+FAILED_WITH_TRACE = """<?xml version="1.0"?>
+<testsuite name="s" tests="1"><testcase classname="corridor.Checks" name="test_check">
+<failure message="AssertionError">Traceback (most recent call last):
+  File "corridor.py", line 40, in test_check
+AssertionError: follower_2 slot RMS 0.93 m over the 0.5 m bound</failure></testcase></testsuite>"""
+
+
+def test_failure_message_is_printed_before_the_totals(tmp_path):
+    (tmp_path / "rosunit-corridor.xml").write_text(FAILED_WITH_TRACE)
+    proc = subprocess.run([sys.executable, SUMMARY, str(tmp_path)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    lines = proc.stdout.strip().splitlines()
+    assert lines[-1] == "0 passed, 1 failed, 0 skipped"
+    reason = [i for i, line in enumerate(lines) if "slot RMS 0.93 m over the 0.5 m bound" in line]
+    assert reason and reason[0] > [i for i, line in enumerate(lines) if "FAILED corridor" in line][0]
