@@ -10,7 +10,7 @@ comes back rejoins as a follower).
 from xml.sax.saxutils import quoteattr
 
 from mbot_navigation.fleet_launch import (LOCALIZATIONS, find_maps_directory, fleet_launch_xml, read_world,
-                                          resolve_world_path, run_launch_text)
+                                          run_launch_text)
 
 OMNI_MODELS = ("mbot_omni",)
 
@@ -61,7 +61,7 @@ def main(argv=None):
         if args.controller not in CONTROL_LAWS:
             raise ValueError("controller %r: expected one of %s" % (args.controller, ", ".join(sorted(CONTROL_LAWS))))
         maps = find_maps_directory(rospkg.RosPack().get_path("mbot_follower"))
-        world = read_world(resolve_world_path(args.world, maps))
+        world = read_world(args.world, maps)
         text = fleet_launch_xml(world, args.localization, config_dir=args.config_dir, output=args.output,
                                 extra_lines=controller_lines(world, args.controller, args.output,
                                                              args.controller_config, args.leader_max_vel))
@@ -69,5 +69,5 @@ def main(argv=None):
         print("formation_fleet: %s" % error, file=sys.stderr)
         return 1
     print("formation_fleet: %d robots of %s: %s (controller %s)" % (
-        len(world.robots), world.path, ", ".join(r.name for r in world.robots), args.controller))
+        len(world.robots), world.file, ", ".join(r.name for r in world.robots), args.controller))
     return run_launch_text(text, "formation_fleet")

@@ -1,4 +1,4 @@
-"""mbot_navigation.fleet_launch without ROS: world files, the generated launch file."""
+"""mbot_navigation.fleet_launch without ROS: world files (read by mbot_common), the generated launch file."""
 import os
 import sys
 import xml.etree.ElementTree as ET
@@ -8,10 +8,11 @@ import pytest
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))  # as the devel space would
 
-from mbot_navigation.fleet_launch import (WorldFileError, find_maps_directory, fleet_launch_xml,  # noqa: E402
-                                          read_world, resolve_world_path)
+from mbot_common.strict_yaml import ConfigError  # noqa: E402
+from mbot_navigation.fleet_launch import find_maps_directory, fleet_launch_xml, read_world  # noqa: E402
 
 MAPS_DIR = os.path.abspath(os.path.join(PACKAGE_DIR, "..", "..", "maps"))
+OFFICE_MAP = os.path.join(MAPS_DIR, "office.yaml")
 
 
 def write(tmp_path, name, text):
@@ -20,47 +21,49 @@ def write(tmp_path, name, text):
     return str(path)
 
 
-def test_finds_the_workspace_maps_and_resolves_names():
+def test_finds_the_workspace_maps_and_resolves_names(tmp_path):
     assert find_maps_directory(PACKAGE_DIR) == MAPS_DIR
-    assert resolve_world_path("office", MAPS_DIR) == os.path.join(MAPS_DIR, "office.world.yaml")
-    test_world = os.path.join(PACKAGE_DIR, "test", "worlds", "nav_office.world.yaml")
-    assert resolve_world_path(test_world, None) == test_world
-    with pytest.raises(WorldFileError, match="no such file"):
-        resolve_world_path("no_such_world", MAPS_DIR)
-    with pytest.raises(WorldFileError, match="no maps directory"):
-        resolve_world_path("office", None)
+    assert read_world("office", MAPS_DIR).file == os.path.join(MAPS_DIR, "office.world.yaml")
+    path = write(tmp_path, "one.world.yaml", "map: %s\nrobots:\n  - {name: a, pose: [0, 0, 0]}\n" % OFFICE_MAP)
+    assert read_world(path).file == path
+    with pytest.raises(ConfigError, match='world "no_such_world": no world file of that name'):
+        read_world("no_such_world", MAPS_DIR)
 
 
 def test_reads_the_office_world():
     world = read_world(os.path.join(MAPS_DIR, "office.world.yaml"))
-    assert world.map_path == os.path.join(MAPS_DIR, "office.yaml")
+    assert os.path.normpath(world.map_path) == OFFICE_MAP
     assert [r.name for r in world.robots] == ["robot_0", "robot_1", "robot_2"]
     assert world.robots[1].model == "mbot"
-    assert (world.robots[1].x, world.robots[1].y, world.robots[1].yaw) == (2.0, -3.0, 0.0)
+    assert tuple(world.robots[1].pose) == (2.0, -3.0, 0.0)
 
 
 def test_world_errors_name_file_and_key(tmp_path):
-    with pytest.raises(WorldFileError, match=r"bad\.world\.yaml: map: expected"):
+    # The same strict reader as stage_node: a launch never starts a fleet the simulator refuses.
+    with pytest.raises(ConfigError, match=r"bad\.world\.yaml.*map"):
         read_world(write(tmp_path, "bad.world.yaml", "robots: []\n"))
-    with pytest.raises(WorldFileError, match=r"robots\[0\]\.pose: expected a list of 3 numbers"):
-        read_world(write(tmp_path, "p.world.yaml", "map: m.yaml\nrobots:\n  - name: a\n    pose: [1, 2]\n"))
-    with pytest.raises(WorldFileError, match=r"robots\[1\]\.name"):
+    with pytest.raises(ConfigError, match=r"p\.world\.yaml: robots\[0\]\.pose"):
+        read_world(write(tmp_path, "p.world.yaml", "map: %s\nrobots:\n  - name: a\n    pose: [1, 2]\n" % OFFICE_MAP))
+    with pytest.raises(ConfigError, match=r"n\.world\.yaml: robots\[1\]\.name"):
         read_world(write(tmp_path, "n.world.yaml",
-                         "map: m.yaml\nrobots:\n  - {name: a, pose: [0, 0, 0]}\n  - {pose: [1, 1, 0]}\n"))
-    with pytest.raises(WorldFileError, match=r"robots\[0\]\.pose: expected a number"):
-        read_world(write(tmp_path, "t.world.yaml", "map: m.yaml\nrobots:\n  - {name: a, pose: [0, x, 0]}\n"))
+                         "map: %s\nrobots:\n  - {name: a, pose: [0, 0, 0]}\n  - {pose: [1, 1, 0]}\n" % OFFICE_MAP))
+    with pytest.raises(ConfigError, match=r"m\.world\.yaml: map"):
+        read_world(write(tmp_path, "m.world.yaml", "map: no_such_map.yaml\nrobots: []\n"))
+    with pytest.raises(ConfigError, match=r"k\.world\.yaml: robots\[0\]\.colour: unknown key"):
+        read_world(write(tmp_path, "k.world.yaml",
+                         "map: %s\nrobots:\n  - {name: a, pose: [0, 0, 0], colour: red}\n" % OFFICE_MAP))
 
 
 def test_launch_file_has_the_map_server_and_one_navigation_per_robot(tmp_path):
-    world = read_world(write(tmp_path, "two.world.yaml", "map: maps/two.yaml\nrobots:\n"
-                             "  - {name: leader, model: mbot_omni, pose: [1.5, -2, 0.5]}\n"
+    world = read_world(write(tmp_path, "two.world.yaml", "map: %s\nrobots:\n" % OFFICE_MAP
+                             + "  - {name: leader, model: mbot_omni, pose: [1.5, -2, 0.5]}\n"
                              "  - {name: follower_1, pose: [0, 0, 3.14159]}\n"))
     root = ET.fromstring(fleet_launch_xml(world, localization="pf", base_global_planner="ompl",
                                           config_dir="/cfg dir"))
     includes = root.findall("include")
     assert [i.get("file").split("/")[-1] for i in includes] == [
         "map_server.launch", "navigation.launch", "navigation.launch"]
-    assert includes[0].find("arg").get("value") == str(tmp_path / "maps" / "two.yaml")
+    assert includes[0].find("arg").get("value") == OFFICE_MAP
     args = [{a.get("name"): a.get("value") for a in i.findall("arg")} for i in includes[1:]]
     assert args[0]["robot"] == "leader" and args[0]["model"] == "mbot_omni"
     assert (args[0]["initial_pose_x"], args[0]["initial_pose_y"], args[0]["initial_pose_a"]) == ("1.5", "-2", "0.5")
