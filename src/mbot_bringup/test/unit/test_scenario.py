@@ -261,3 +261,24 @@ def test_the_criteria_window_leaves_out_start_up_and_shut_down():
     assert summary["fleet"]["tf_success_rate"] == pytest.approx(1.0 - 1.0 / 200.0)   # (210 - 10) lookups, 1 failure
     assert summary["fleet"]["contacts"] == 0 and summarize(run)["fleet"]["contacts"] == 1
     assert summary["fleet"]["time_in_state_s"] == {"IDLE": 2.0, "NAVIGATING": 4.0}
+
+
+def test_run_dir_is_emptied_only_when_an_earlier_run_wrote_it(tmp_path):
+    from mbot_bringup.scenario_runner import prepare_run_dir
+
+    other = tmp_path / "notes"
+    other.mkdir()
+    (other / "thesis.tex").write_text("keep me")
+    with pytest.raises(ConfigError, match="not empty and not a run dir"):
+        prepare_run_dir(str(other))
+    assert (other / "thesis.tex").read_text() == "keep me"
+
+    earlier = tmp_path / "run"
+    earlier.mkdir()
+    (earlier / "scenario.yaml").write_text("world: office\n")
+    (earlier / "run.bag").write_text("old")
+    prepare_run_dir(str(earlier))
+    assert earlier.is_dir() and os.listdir(str(earlier)) == []
+
+    prepare_run_dir(str(tmp_path / "new" / "run"))
+    assert (tmp_path / "new" / "run").is_dir()
