@@ -29,7 +29,8 @@ Metric = namedtuple("Metric", "key label unit scale digits better")
 METRICS = [
     Metric("arrived", "arrived at the target", "", 1, 0, "higher"),
     Metric("arrival_s", "arrival: target to ARRIVED", "s", 1, 2, "lower"),
-    Metric("steady_navigating_slot_rms_m", "formation error, RMS while moving", "m", 1, 3, "lower"),
+    Metric("steady_navigating_slot_rms_m", "formation error, RMS while moving (slots free)", "m", 1, 3, "lower"),
+    Metric("slot_blocked_share", "share of moving time with a slot in a wall", "%", 100, 1, None),
     Metric("steady_arrived_slot_rms_m", "formation error, RMS after arrival", "m", 1, 3, "lower"),
     Metric("slot_rms_m", "formation error, RMS over the whole run", "m", 1, 3, "lower"),
     Metric("slot_p95_m", "formation error, 95th percentile", "m", 1, 3, "lower"),

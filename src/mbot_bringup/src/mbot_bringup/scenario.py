@@ -54,7 +54,7 @@ ACTIONS = {
 #: metrics summary (mbot_follower.metrics.summarize), from the run (switch times) and from what
 #: the runner saw (facts: arrivals, goals, failed steps).
 CRITERIA = {
-    "steady_navigating_slot_rms_m": ("<=", float, "slot error RMS while NAVIGATING with the leader moving [m]"),
+    "steady_navigating_slot_rms_m": ("<=", float, "slot RMS, NAVIGATING, leader moving, slots clear of walls [m]"),
     "steady_arrived_slot_rms_m": ("<=", float, "slot error RMS while ARRIVED [m]"),
     "slot_rms_m": ("<=", float, "slot error RMS over the whole run [m]"),
     "fit_rms_m": ("<=", float, "shape error RMS after the best rigid fit [m]"),

@@ -73,8 +73,8 @@ def test_criteria_table_shows_criteria_json_with_units(report):
     values = dict((c["name"], c["value"]) for c in criteria)
     assert values["steady_navigating_slot_rms_m"] == pytest.approx(fleet["steady_navigating_slot_rms_m"])
     assert values["latency_p95_s"] == pytest.approx(fleet["latency_p95_s"])
-    assert row_cells(page, "formation error, RMS while moving") == [
-        "formation error, RMS while moving", "steady_navigating_slot_rms_m",
+    assert row_cells(page, "formation error, RMS while moving (slots free)") == [
+        "formation error, RMS while moving (slots free)", "steady_navigating_slot_rms_m",
         "%.3f" % fleet["steady_navigating_slot_rms_m"], "&lt;=", "0.150", "m", "FAIL"]
     assert fleet["steady_navigating_slot_rms_m"] > 0.15
     # the fixture's latency limit is 0.2 s, not the lab's 0.12 s: the page uses criteria.json
@@ -226,7 +226,7 @@ def test_compare_by_the_script_defaults_to_run_b_compare(tmp_path):
     assert out.stdout.strip() == os.path.join(b, "compare", "index.html")
     with open(out.stdout.strip()) as f:
         page = f.read()
-    assert row_cells(page, "formation error, RMS while moving")[4:] == ["+0.000", "same"]
+    assert row_cells(page, "formation error, RMS while moving (slots free)")[4:] == ["+0.000", "same"]
 
 
 # --- inputs that are missing or broken ---------------------------------------------------------

@@ -201,12 +201,9 @@ class CoordinatorNode(object):
     # --- inputs -------------------------------------------------------------------------------
 
     def _on_map(self, msg):
-        import numpy as np
-
-        grid = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
-        origin = (msg.info.origin.position.x, msg.info.origin.position.y)
+        free_space = FreeSpace.from_grid_msg(msg, self.params["map_clearance"])
         with self.lock:
-            self.core.free_space = FreeSpace(grid, msg.info.resolution, origin, self.params["map_clearance"])
+            self.core.free_space = free_space
 
     def _on_controller(self, msg, robot):
         self.last_heard_controller[robot] = msg.header.stamp.to_sec()

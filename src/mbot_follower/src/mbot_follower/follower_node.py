@@ -148,11 +148,7 @@ class FollowerController(object):
         self.scan = msg
 
     def _on_map(self, msg):
-        import numpy as np
-
-        grid = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
-        origin = (msg.info.origin.position.x, msg.info.origin.position.y)
-        self.free_space = FreeSpace(grid, msg.info.resolution, origin, self.params["map_clearance"])
+        self.free_space = FreeSpace.from_grid_msg(msg, self.params["map_clearance"])
 
     def _on_leader_odom(self, msg):
         t = msg.twist.twist

@@ -55,6 +55,13 @@ class FreeSpace(object):
             blocked = np.zeros(grid.shape, dtype=bool)
         self.free = ~blocked & (grid >= 0)    # [row, column]: True where a robot may be
 
+    @classmethod
+    def from_grid_msg(cls, msg, clearance):
+        """The free space of a nav_msgs/OccupancyGrid message (anything with its fields)."""
+        grid = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
+        origin = (msg.info.origin.position.x, msg.info.origin.position.y)
+        return cls(grid, msg.info.resolution, origin, clearance)
+
     def cell(self, x, y):
         """(row, column) of the cell holding world point (x, y), or None outside the map."""
         col = int(math.floor((x - self.origin_xy[0]) / self.resolution))

@@ -18,7 +18,14 @@ What the numbers mean (all times sim time unless marked wall):
                     status' `lost`) is excluded while lost; so is a robot without a fresh pose.
   fit error         the same after the best rigid fit (rotation + translation) of the desired
                     shape onto the actual positions (shape.rigid_fit): the shape alone.
-  steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED.
+  slot free         whether a follower's slot keeps slot_clearance to the walls of the map (1/0;
+                    NaN without a map): a slot in a wall (a column's slots behind a corner, a
+                    wide formation in a doorway) cannot be held, the follower drives the free
+                    path instead (the leader's trail).
+  steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED;
+                    while navigating, a follower's sample counts once its slot has been free
+                    for free_hold (the time to get back from the trail). slot_blocked_share
+                    says how much of the navigating time the slots were in walls.
   leader lateral    distance of the leader from the polyline of its global plan (the newest one not
                     later than the leader's pose; a new goal, FORMING, forgets the old plans); the
                     summary counts it while the leader follows the plan (NAVIGATING, DEGRADED).
@@ -63,7 +70,9 @@ PLAN_STATES = ("NAVIGATING", "DEGRADED")   # the leader follows its global plan
 
 #: One robot in one sample. x, y [m] and theta [rad] in map (NaN: no fresh pose);
 #: slot_error, fit_error [m] (NaN: not a measured follower); distance [m] and energy [J] so far.
-RobotSample = namedtuple("RobotSample", "x y theta slot_error fit_error distance energy")
+#: slot_free: 1.0 / 0.0 if the slot is / is not free in the map, NaN when unknown.
+RobotSample = namedtuple("RobotSample", "x y theta slot_error fit_error distance energy slot_free",
+                         defaults=(NAN,))
 
 #: The fleet at one sample time t [s]. Errors in [m] (heading_max [rad]), NaN when nothing was
 #: measured; lost: tuple of names; clearance_pair: "a b" of the closest robots ("" if < 2 robots);
@@ -86,7 +95,8 @@ class MetricsConfig(object):
     """Parameters of the metrics (the node reads them from its private parameters)."""
 
     def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
-                 robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0):
+                 robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0,
+                 slot_clearance=0.25, free_hold=3.0):
         self.rate = rate                      # samples per sim second [Hz]
         self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
@@ -96,13 +106,16 @@ class MetricsConfig(object):
         self.moving_speed = moving_speed      # a leader faster than this is moving [m/s]
         self.teleport_speed = teleport_speed  # a faster jump between two poses is a teleport, not travel [m/s]
         self.hold_back = hold_back            # a sample waits this long for a late robot's poses [s]
+        self.slot_clearance = slot_clearance  # a slot closer than this to a wall is not free [m]
+        self.free_hold = free_hold            # a slot free this long counts in the steady RMS [s]
         self.check()
 
     def check(self):
         """ValueError naming the first bad value (every value must be a finite number)."""
         limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
-                  ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True)]
+                  ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True),
+                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True)]
         for key, low, low_ok in limits:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
@@ -152,9 +165,10 @@ def distance_to_polyline(x, y, points):
 class MetricsCollector(object):
     """Builds a Run from message contents; every `on_*` takes the sim time t [s] of its message."""
 
-    def __init__(self, config=None):
+    def __init__(self, config=None, free_space=None):
         self.config = config or MetricsConfig()
         self.run = Run(self.config)
+        self.free_space = free_space   # free_space.FreeSpace of the map (slot_clearance), None: no map yet
         self.assignment = None   # fleet_io.Assignment (or anything with .leader .formation .spacing .slots)
         self.state = ""          # coordinator state, "" before the first status
         self.lost = ()           # robots the status reports lost
@@ -306,7 +320,7 @@ class MetricsCollector(object):
         a = entry[1] if entry is not None else None
         entry = self._in_force(self._statuses, t)
         state, lost = (entry[1], entry[2]) if entry is not None else ("", ())
-        slot_error, fit_error = {}, {}
+        slot_error, fit_error, slot_free = {}, {}, {}
         errors = ShapeErrors(NAN, NAN, NAN, NAN, NAN, NAN)   # no follower measured
         lateral = NAN
         leader = a.leader if a is not None else ""
@@ -322,6 +336,8 @@ class MetricsCollector(object):
                 for i, r in enumerate(followers, start=1):
                     slot_error[r] = math.hypot(actual[i][0] - desired[i][0], actual[i][1] - desired[i][1])
                     fit_error[r] = math.hypot(actual[i][0] - fitted[i][0], actual[i][1] - fitted[i][1])
+                    if self.free_space is not None:
+                        slot_free[r] = 1.0 if self.free_space.is_free(*desired[i]) else 0.0
             # The plan in force when the leader was where its pose says: under load the 100 Hz
             # ground truth may lag behind the plans, and a plan that starts ahead of an old pose
             # is not the leader's lateral error.
@@ -340,7 +356,7 @@ class MetricsCollector(object):
             x, y, theta = fresh.get(r, (NAN, NAN, NAN))
             distance = at_t[r][4] if r in at_t else self.distance[r]
             robots[r] = RobotSample(x, y, theta, slot_error.get(r, NAN), fit_error.get(r, NAN), distance,
-                                    self.energy[r])
+                                    self.energy[r], slot_free.get(r, NAN))
         return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)
@@ -492,20 +508,33 @@ def summarize(run):
         robots[r] = entry
 
     # Steady errors: ARRIVED, and NAVIGATING while the leader moves (its speed from this sample
-    # and the one before).
+    # and the one before) for the followers whose slots have been free for free_hold.
     navigating, arrived = [], []
+    blocked_since = {}   # robot -> time of its slot's newest blocked sample
+    moving_samples = blocked_samples = 0
     for i, s in enumerate(run.samples):
+        for r, rs in s.robots.items():
+            if rs.slot_free == 0.0:
+                blocked_since[r] = s.t
         followers = [rs.slot_error for rs in s.robots.values()]
         if s.state == "ARRIVED":
             arrived += followers
         elif s.state == "NAVIGATING" and i > 0 and _leader_speed(run.samples[i - 1], s) > config.moving_speed:
-            navigating += followers
+            for r, rs in s.robots.items():
+                if not math.isfinite(rs.slot_error):
+                    continue
+                moving_samples += 1
+                if s.t - blocked_since.get(r, -math.inf) >= config.free_hold - 1e-9:
+                    navigating.append(rs.slot_error)
+                if rs.slot_free == 0.0:
+                    blocked_samples += 1
 
     fleet = {"slot_samples": len(_finite(pooled_slot))}
     fleet.update(_stats(pooled_slot, "slot", "m", rms=True, percentiles=(95,)))
     fleet.update(_stats(pooled_fit, "fit", "m", rms=True, percentiles=(95,)))
     fleet["steady_navigating_slot_rms_m"] = _rms(navigating)
     fleet["steady_arrived_slot_rms_m"] = _rms(arrived)
+    fleet["slot_blocked_share"] = blocked_samples / moving_samples if moving_samples else None
     lateral = [s.leader_lateral for s in run.samples if s.state in PLAN_STATES]
     fleet.update(_stats(lateral, "leader_lateral", "m", rms=True))
     fleet.update(_controller_stats(run.controller))
@@ -543,7 +572,9 @@ def summarize(run):
 SAMPLE_COLUMNS = ["t_s", "state", "leader", "formation", "lost", "slot_rms_m", "slot_max_m", "fit_rms_m",
                   "fit_max_m", "edge_max_m", "heading_max_rad", "leader_lateral_m", "min_clearance_m",
                   "clearance_pair"]
-ROBOT_COLUMNS = ["x_m", "y_m", "theta_rad", "slot_error_m", "fit_error_m", "distance_m", "energy_j"]
+ROBOT_COLUMNS = ["x_m", "y_m", "theta_rad", "slot_error_m", "fit_error_m", "distance_m", "energy_j", "slot_free"]
+#: what runs recorded before slot_free have
+OLD_ROBOT_COLUMNS = ROBOT_COLUMNS[:-1]
 EVENT_COLUMNS = ["t_s", "kind", "name", "detail", "x_m", "y_m"]
 CONTROLLER_COLUMNS = ["t_s", "robot", "latency_s", "cycle_time_ms", "lookups", "lookup_failures", "mode"]
 FILES = ("metrics.csv", "events.csv", "controller.csv", "metrics.json")
@@ -670,10 +701,13 @@ def load_run(output_dir):
     if header[:len(SAMPLE_COLUMNS)] != SAMPLE_COLUMNS:
         raise RunFileError("%s: line 1: expected the columns to start with %s" % (path, ",".join(SAMPLE_COLUMNS)))
     robot_columns = header[len(SAMPLE_COLUMNS):]
-    run.robots = []
-    for column in robot_columns[::len(ROBOT_COLUMNS)]:
-        run.robots.append(column.rsplit("/", 1)[0])
-    if robot_columns != sample_columns(run.robots)[len(SAMPLE_COLUMNS):]:
+    run.robots, per_robot = None, None
+    for columns in (ROBOT_COLUMNS, OLD_ROBOT_COLUMNS):   # an old run has no slot_free: NaN (unknown)
+        names = [c.rsplit("/", 1)[0] for c in robot_columns[::len(columns)]]
+        if robot_columns == ["%s/%s" % (r, c) for r in names for c in columns]:
+            run.robots, per_robot = names, columns
+            break
+    if per_robot is None:
         raise RunFileError("%s: line 1: expected %s for every robot after the fleet columns, got %s"
                            % (path, ",".join("<robot>/" + c for c in ROBOT_COLUMNS), ",".join(robot_columns)))
     n = len(SAMPLE_COLUMNS)
@@ -682,7 +716,7 @@ def load_run(output_dir):
             return _float(path, number, header[i], row[i])
         robots = {}
         for k, r in enumerate(run.robots):
-            cells = range(n + k * len(ROBOT_COLUMNS), n + (k + 1) * len(ROBOT_COLUMNS))
+            cells = range(n + k * len(per_robot), n + (k + 1) * len(per_robot))
             if any(row[i] != "" for i in cells):   # all empty: the robot was not known yet
                 robots[r] = RobotSample(*[num(i) for i in cells])
         run.samples.append(Sample(num(0), row[1], row[2], row[3], tuple(row[4].split()), num(5), num(6),

@@ -1,6 +1,7 @@
 """Node ``metrics_collector``: the ROS side of the formation metrics (the numbers are metrics.py).
 
-Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts`` and per robot
+Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts``, ``/map`` (is a slot
+in a wall?) and per robot
 ``/<ns>/base_pose_ground_truth`` (frame map), ``/<ns>/follower_controller/state``,
 ``/<ns>/power`` and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
 robot that appears in an assignment (subscribed when it first appears).
@@ -14,8 +15,8 @@ waits for in lockstep, so that its sim time does not run ahead of what was measu
 Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~physics_step`` 0.01 s added to every
 latency (the simulator applies a command at its next step), ``~recovered_rms`` 0.15 m and
 ``~recovered_hold`` 1 s (recovery after a loss), ``~robot_radius`` 0.15 m (clearance),
-``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s, ``~hold_back`` 5 s (see
-MetricsConfig).
+``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s, ``~hold_back`` 5 s,
+``~slot_clearance`` 0.25 m and ``~free_hold`` 3 s (see MetricsConfig).
 A message without a stamp (zero) counts at the time it arrives.
 """
 import math
@@ -23,12 +24,13 @@ import threading
 
 import rospy
 from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
-from nav_msgs.msg import Odometry, Path
+from nav_msgs.msg import OccupancyGrid, Odometry, Path
 from std_msgs.msg import Float64, Header
 
 from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
 from mbot_follower.fleet_io import assignment_from_msg
+from mbot_follower.free_space import FreeSpace
 from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter
 
 #: Node parameters that are not MetricsConfig fields: name -> (kind, default).
@@ -82,6 +84,7 @@ class MetricsNode(object):
             rospy.Subscriber("/fleet/assignment", FleetAssignment, self.on_assignment, queue_size=10),
             rospy.Subscriber("/fleet/status", FleetStatus, self.on_status, queue_size=10),
             rospy.Subscriber("/contacts", Contact, self.on_contact, queue_size=100),
+            rospy.Subscriber("/map", OccupancyGrid, self.on_map, queue_size=1),
         ]
         for robot in robots:
             self.attach(robot)
@@ -109,6 +112,11 @@ class MetricsNode(object):
         if not self.fixed_robots:
             for robot in [assignment.leader] + sorted(assignment.slots):
                 self.attach(robot)
+
+    def on_map(self, msg):
+        free_space = FreeSpace.from_grid_msg(msg, self.collector.config.slot_clearance)
+        with self.lock:
+            self.collector.free_space = free_space
 
     def on_status(self, msg):
         with self.lock:

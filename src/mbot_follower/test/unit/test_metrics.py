@@ -425,3 +425,54 @@ def test_bad_config_and_bad_files_name_the_problem(tmp_path):
         load_run(str(tmp_path))
     with pytest.raises(OSError, match="cannot create it"):
         RunWriter(str(tmp_path / "metrics.csv" / "sub"))
+
+
+def test_a_slot_in_a_wall_leaves_the_steady_rms_until_it_has_been_free_for_free_hold(tmp_path):
+    """A column passes a wall: the follower's slot (1 m behind the leader) crosses a block that
+    fills x in [0.5, 1.5), y in [-1.5, -0.5); with 0.25 m clearance the slot is blocked for x in
+    [0.25, 1.75), i.e. from about 2.5 s to 5.5 s. The follower drives around it 0.8 m off its
+    slot, is still 0.4 m off until 7 s, then 0.1 m. The steady RMS counts it again free_hold (3 s) after
+    its slot is free, so only the 0.1 m samples."""
+    from mbot_follower.free_space import FreeSpace
+
+    grid = np.zeros((40, 100), dtype=np.int8)       # 0.1 m cells, origin (-2, -2): x in [-2, 8), y in [-2, 2)
+    grid[5:15, 25:35] = 100
+    free = FreeSpace(grid, 0.1, (-2.0, -2.0), 0.25)
+    c = MetricsCollector(MetricsConfig(free_hold=3.0), free)
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+    c.on_status(0.0, "NAVIGATING", "", [])
+
+    def poses(t):
+        lx = 0.5 * t
+        error = 0.8 if not free.is_free(lx - 1.0, -1.0) else (0.4 if 5.0 <= t < 7.0 else 0.1)
+        return {"robot_0": (lx, -1.0, 0.0), "robot_1": (lx - 1.0, -1.0 - error, 0.0)}
+
+    drive(c, 0.0, 14.0, poses)
+    s = summarize(c.run)["fleet"]
+    track = [(x.t, x.robots["robot_1"]) for x in c.run.samples]
+    blocked = [t for t, rs in track if rs.slot_free == 0.0]
+    assert blocked[0] == pytest.approx(2.5, abs=0.25) and blocked[-1] == pytest.approx(5.5, abs=0.25)  # cell edges
+    assert all(rs.slot_free == 1.0 for t, rs in track if t < blocked[0] or t > blocked[-1])
+    assert s["steady_navigating_slot_rms_m"] == pytest.approx(0.1)
+    assert s["slot_rms_m"] > 0.35
+    assert s["slot_blocked_share"] == pytest.approx(len(blocked) / (len(track) - 1.0))
+
+    writer = RunWriter(str(tmp_path / "run"))
+    writer.write(c.run, summarize(c.run))
+    back = load_run(str(tmp_path / "run"))
+    assert [x.robots["robot_1"].slot_free for x in back.samples] == [rs.slot_free for _, rs in track]
+    assert summarize(back) == summarize(c.run)
+
+
+def test_a_run_recorded_before_slot_free_reads_as_unknown(tmp_path):
+    c = loss_and_rejoin_run()
+    RunWriter(str(tmp_path)).write(c.run, summarize(c.run))
+    path = tmp_path / "metrics.csv"
+    rows = [line.split(",") for line in path.read_text().splitlines()]
+    keep = [i for i, name in enumerate(rows[0]) if not name.endswith("/slot_free")]
+    path.write_text("\n".join(",".join(row[i] for i in keep) for row in rows) + "\n")
+    back = load_run(str(tmp_path))
+    assert len(back.samples) == len(c.run.samples)
+    assert all(math.isnan(rs.slot_free) for s in back.samples for rs in s.robots.values())
+    assert summarize(back)["fleet"]["steady_navigating_slot_rms_m"] == \
+        summarize(c.run)["fleet"]["steady_navigating_slot_rms_m"]
