@@ -294,7 +294,7 @@ class Series(object):
         self.fit_rms = np.array([s.fit_rms for s in run.samples], dtype=float)             # [m]
         self.leader_lateral = np.array([s.leader_lateral for s in run.samples], dtype=float)  # [m]
         self.robots = list(run.robots)
-        self.x, self.y, self.theta, self.slot_error, self.distance = {}, {}, {}, {}, {}
+        self.x, self.y, self.theta, self.slot_error, self.distance, self.slot_blocked = {}, {}, {}, {}, {}, {}
         for r in self.robots:
             rows = [s.robots.get(r) for s in run.samples]
             self.x[r] = np.array([p.x if p else np.nan for p in rows], dtype=float)             # [m]
@@ -302,6 +302,7 @@ class Series(object):
             self.theta[r] = np.array([p.theta if p else np.nan for p in rows], dtype=float)     # [rad]
             self.slot_error[r] = np.array([p.slot_error if p else np.nan for p in rows], dtype=float)  # [m]
             self.distance[r] = np.array([p.distance if p else np.nan for p in rows], dtype=float)   # so far [m]
+            self.slot_blocked[r] = np.array([bool(p) and p.slot_free == 0.0 for p in rows])  # slot in a wall
 
     def pose(self, robot, i):
         """(x, y, theta) of robot at sample i, or None without a pose."""

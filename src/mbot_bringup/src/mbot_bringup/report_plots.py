@@ -285,6 +285,14 @@ def plot_errors(run, colors, path, formation_limit, lateral_limit):
                    label="limit %.2f m (RMS while\nNAVIGATING and moving)" % formation_limit)
     moving = np.array([s in ("NAVIGATING", "DEGRADED", "ARRIVED") for s in series.state])
     top = error_limit(series.slot_rms[moving] if moving.any() else series.slot_rms, formation_limit)
+    # A bar along the bottom, one row per follower, where its slot lay in a wall (it drove the
+    # free path instead): the error there is not the controller's.
+    for k, r in enumerate(series.followers()):
+        blocked = series.slot_blocked[r]
+        if blocked.any():
+            y = top * (0.015 + 0.03 * k)
+            ax.plot(series.t, np.where(blocked, y, np.nan), "-", color=colors[r], lw=5, solid_capstyle="butt",
+                    label="%s: slot in a wall" % r)
     ax.set_ylim(0.0, top)
     ax.set_ylabel("slot error [m]")
     ax.set_title("Formation error over time" + _cut_note(

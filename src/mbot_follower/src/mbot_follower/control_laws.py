@@ -234,6 +234,12 @@ class CommandFilter(object):
     def reset(self):
         self.previous = Twist2D(0.0, 0.0, 0.0)
 
+    def sent(self, cmd):
+        """Tell the filter what was sent instead of its output (the safety layer stopped the
+        travel but let the turn through): the next command smooths from that, so a held robot
+        keeps turning at its full rate instead of starting its turn from zero every cycle."""
+        self.previous = Twist2D(*cmd)
+
     def apply(self, cmd, dt):
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError("CommandFilter.apply: dt must be a finite time > 0 [s], got %r" % (dt,))

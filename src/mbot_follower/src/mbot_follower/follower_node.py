@@ -215,7 +215,7 @@ class FollowerController(object):
             # The safety layer has the last word: smoothing must not carry the robot on into something.
             cmd, self._held = safety_filter(cmd, *scan, config=self.config)
             if self._held:
-                self.filter.reset()
+                self.filter.sent(cmd)
                 mode = "safety_stop"
         self._send(cmd)
         self._was_driving = True

@@ -218,6 +218,23 @@ def test_filter_smooths_then_limits_velocity():
     assert tuple(f.apply(Twist2D(0.1, 0.0, 0.0), DT)) == pytest.approx((0.03, 0.0, 0.0))
 
 
+def test_a_robot_held_by_the_safety_layer_keeps_turning_at_its_full_rate():
+    """A wall 0.5 m ahead: every cycle the safety layer stops the travel and lets the turn
+    through. Told what was sent, the filter keeps the turn's rate; the robot turns away."""
+    from mbot_follower.control_laws import safety_filter
+
+    config = ControllerConfig(max_angular_accel=100.0)
+    n = 360
+    ranges = [0.5 if abs(-math.pi + (i + 0.5) * 2 * math.pi / n) < math.radians(40) else float("inf")
+              for i in range(n)]
+    f = CommandFilter(config)
+    for _ in range(20):
+        out, held = safety_filter(f.apply(Twist2D(0.3, 0.0, 1.0), DT), ranges, -math.pi, 2 * math.pi / n, config)
+        assert held and out.vx == 0.0
+        f.sent(out)
+    assert out.wz == pytest.approx(1.0, abs=0.01)   # smoothed up to the full command, not 30 % of it
+
+
 def test_filter_limits_acceleration_and_reads_the_config_live():
     config = ControllerConfig(smoothing=1.0)       # no smoothing: the limits alone
     f = CommandFilter(config)
