@@ -231,6 +231,7 @@ class Lane(object):
     def __init__(self, robot, client, goals, spares, tolerance):
         self.robot, self.client, self.goals, self.spares, self.tolerance = robot, client, goals, spares, tolerance
         self.pose = []       # ground truth (x, y) [m], updated by its subscriber
+        self.estimate = []   # the localization's last amcl_pose (x, y) [m]: why a goal ends off
         self.next = 0        # index of the next goal in `goals`
         self.goal = None     # the goal it drives to (x, y, yaw), None when idle
         self.started = None  # sim time the goal was sent
@@ -245,13 +246,15 @@ class Lane(object):
 
 def drive(args, log, process=None):
     import rospy
-    from actionlib import SimpleGoalState
     from actionlib_msgs.msg import GoalStatus
     from mbot_msgs.msg import Contact
+    from geometry_msgs.msg import PoseWithCovarianceStamped
     from nav_msgs.msg import OccupancyGrid, Odometry
 
     from mbot_navigation.move_base_client import connect_move_base, make_goal
 
+    ENDED = (GoalStatus.PREEMPTED, GoalStatus.SUCCEEDED, GoalStatus.ABORTED, GoalStatus.REJECTED,
+             GoalStatus.RECALLED, GoalStatus.LOST)
     wait_for_sim_time("nav_trial", args.launch_log)
     rospy.init_node("nav_trial", disable_signals=True)
     robots = trial_robots(args)
@@ -270,6 +273,9 @@ def drive(args, log, process=None):
         lane = Lane(robot, client, None, None, goal_tolerance(robot))
         rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry,
                          lambda m, pose=lane.pose: pose.__setitem__(
+                             slice(None), [m.pose.pose.position.x, m.pose.pose.position.y]))
+        rospy.Subscriber("/%s/amcl_pose" % robot, PoseWithCovarianceStamped,
+                         lambda m, estimate=lane.estimate: estimate.__setitem__(
                              slice(None), [m.pose.pose.position.x, m.pose.pose.position.y]))
         deadline = time.time() + 60.0
         while not lane.pose and time.time() < deadline:
@@ -302,7 +308,7 @@ def drive(args, log, process=None):
                 lane.started, lane.cancelled, lane.contacts_before = now, None, len(contacts)
                 lane.client.send_goal(make_goal(*lane.goal))
                 continue
-            done = lane.client.get_simple_state() == SimpleGoalState.DONE
+            done = lane.client.get_state() in ENDED
             elapsed = (now - lane.started).to_sec()
             if not done and lane.cancelled is None and elapsed > args.timeout:
                 lane.client.cancel_goal()
@@ -316,14 +322,18 @@ def drive(args, log, process=None):
             outcome = {"robot": lane.robot, "goal": [round(x, 2), round(y, 2), round(yaw, 2)],
                        "replaced": lane.replaced, "succeeded": succeeded, "state": state,
                        "text": why or lane.client.get_goal_status_text(), "sim_seconds": round(elapsed, 1),
-                       "contacts": len(contacts) - lane.contacts_before, "end": [round(v, 3) for v in lane.pose]}
+                       "contacts": len(contacts) - lane.contacts_before, "end": [round(v, 3) for v in lane.pose],
+                       "estimate": [round(v, 3) for v in lane.estimate]}
             outcomes.append(outcome)
             lane.goal = None
             log("run %d/%d %s: (%.2f, %.2f, %.2f)%s %s in %.1f sim s, contacts %d%s" % (
                 len(outcomes), args.runs, lane.robot, x, y, yaw, " (replaced)" if lane.replaced else "",
                 "ok" if succeeded else "FAILED", elapsed, outcome["contacts"],
-                "" if succeeded else " (%s; state %d %r, ended at %.2f, %.2f)" % (
-                    why, state, lane.client.get_goal_status_text(), lane.pose[0], lane.pose[1])))
+                "" if succeeded else " (%s; state %d %r, truly at %.2f, %.2f, localized at %s; others at %s)" % (
+                    why, state, lane.client.get_goal_status_text(), lane.pose[0], lane.pose[1],
+                    ", ".join("%.2f" % v for v in lane.estimate) or "-",
+                    "; ".join("%s %.2f, %.2f" % (o.robot, o.pose[0], o.pose[1])
+                              for o in lanes if o is not lane) or "-")))
         time.sleep(0.01)  # wall: a poll; sim time may run many times faster (or stand still)
     result = summary(outcomes, len(contacts) - contacts_start, (rospy.Time.now() - sim_start).to_sec(),
                      time.time() - wall_start, len(robots))
