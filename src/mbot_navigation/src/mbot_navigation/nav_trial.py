@@ -322,7 +322,9 @@ def drive(args, log, process=None):
             outcome = {"robot": lane.robot, "goal": [round(x, 2), round(y, 2), round(yaw, 2)],
                        "replaced": lane.replaced, "succeeded": succeeded, "state": state,
                        "text": why or lane.client.get_goal_status_text(), "sim_seconds": round(elapsed, 1),
-                       "contacts": len(contacts) - lane.contacts_before, "end": [round(v, 3) for v in lane.pose],
+                       "contacts": len(contacts) - lane.contacts_before,
+                       "contact_pairs": ["%s-%s" % (c.body_a, c.body_b) for c in contacts[lane.contacts_before:]],
+                       "end": [round(v, 3) for v in lane.pose],
                        "estimate": [round(v, 3) for v in lane.estimate]}
             outcomes.append(outcome)
             lane.goal = None
