@@ -7,7 +7,10 @@
                                       one plan per pair; fastest of 5 beside it), DWA cycle time
                                       (defaults and the shipped nav_dwa.yaml), and the seeded
                                       random-goal navigation trial in `office`
-        --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 0: as fast as possible)
+        --trial-runs N (default 100; 0 skips it), --trial-rtf X (default 0: as fast as possible);
+                                      and the fleet trial: 3 robots at once in `office` with its
+                                      walking person, particle filter, goals split among them
+        --fleet-runs N (default 100 in all; 0 skips it)
     scripts/bench formation [--json FILE] [--seeds N] [--sizes 3,5,10]
                                       the formation fleet at real_time_factor 0 with lockstep:
                                       convergence, straight and route slot error, switch time,
@@ -101,6 +104,15 @@ def bench_sim(runs=3):
             "sim_runs": details, "sim_runs_all": all_runs}
 
 
+def run_nav_trial(options):
+    """mbot_navigation's nav_trial with `options` (a list); the JSON object it prints."""
+    script = os.path.join(ROOT, "src", "mbot_navigation", "scripts", "nav_trial")
+    print("$ nav_trial " + " ".join(options), file=sys.stderr)
+    out = subprocess.run(["/usr/bin/python3", script] + options + ["--json"],
+                         check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
+    return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
+
+
 def nav_trial(runs, rtf):
     """Seeded random-goal trial: one robot in `office`, each run one goal with a timeout.
 
@@ -109,17 +121,21 @@ def nav_trial(runs, rtf):
     default, the issue's condition) sim time runs as fast as the nav node and the localization can
     follow, never ahead of them.
     """
-    script = os.path.join(ROOT, "src", "mbot_navigation", "scripts", "nav_trial")
-    print("$ nav_trial --runs %d --seed 1 --real-time-factor %g --json" % (runs, rtf), file=sys.stderr)
-    out = subprocess.run(["/usr/bin/python3", script, "--runs", str(runs), "--seed", "1",
-                          "--real-time-factor", str(rtf), "--json"],
-                         check=True, stdout=subprocess.PIPE, universal_newlines=True).stdout
-    result = json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
+    result = run_nav_trial(["--runs", str(runs), "--seed", "1", "--real-time-factor", str(rtf)])
     result["real_time_factor"] = rtf
     return result
 
 
-def bench_nav(trial_runs=100, trial_rtf=0.0):
+def nav_trial_fleet(runs, rtf):
+    """The harder trial: the 3 robots of maps/office.world.yaml at once, with its walking person,
+    particle-filter localization, `runs` goals split among them (nav_trial --robots 3)."""
+    result = run_nav_trial(["--robots", "3", "--world", os.path.join(ROOT, "maps", "office.world.yaml"),
+                            "--localization", "pf", "--runs", str(runs), "--seed", "1",
+                            "--real-time-factor", str(rtf), "--launch-log", "/tmp/nav_trial_fleet_roslaunch.log"])
+    return {k: result[k] for k in ("robots", "runs", "succeeded", "contacts", "mean_goal_s")}
+
+
+def bench_nav(trial_runs=100, trial_rtf=0.0, fleet_runs=100):
     # The planner as the nav node runs it: nav_move_base.yaml's GlobalPlanner settings.
     plan = {}
     single = {}
@@ -141,6 +157,8 @@ def bench_nav(trial_runs=100, trial_rtf=0.0):
               "dwa_ms_shipped": {"p50": shipped["p50"], "p99": shipped["p99"], "wall_p99": shipped["wall_p99"]}}
     if trial_runs > 0:
         result["trial"] = nav_trial(trial_runs, trial_rtf)
+    if fleet_runs > 0:
+        result["trial_fleet"] = nav_trial_fleet(fleet_runs, trial_rtf)
     return result
 
 
@@ -193,6 +211,11 @@ def print_table(result):
         print("\nNavigation trial (office, real_time_factor %g): %d of %d goals reached, %d contacts, "
               "%.0f sim s in %.0f wall s" % (t["real_time_factor"], t["succeeded"], t["runs"], t["contacts"],
                                              t["sim_seconds"], t["wall_seconds"]))
+    if "trial_fleet" in result:
+        t = result["trial_fleet"]
+        print("Fleet trial (office with its walking person, %d robots at once, particle filter): %d of %d goals"
+              " reached, %d contacts, %s sim s per goal reached" % (t["robots"], t["succeeded"], t["runs"],
+                                                                    t["contacts"], t["mean_goal_s"]))
 
 
 def main(argv=None):
@@ -202,6 +225,8 @@ def main(argv=None):
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
     parser.add_argument("--trial-rtf", type=float, default=0.0,
                         help="real-time factor of the trial (default 0: as fast as possible, lockstep)")
+    parser.add_argument("--fleet-runs", type=int, default=100,
+                        help="goals of the fleet trial (3 robots, person, particle filter; 0: skip)")
     parser.add_argument("--sim-runs", type=int, default=3, help="sim: runs per fleet size (median and range)")
     parser.add_argument("--seeds", type=int, default=10, help="formation: seeds per fleet size")
     parser.add_argument("--sizes", default="3,5,10", help="formation: fleet sizes")
@@ -212,7 +237,7 @@ def main(argv=None):
     if args.what in ("sim", "all"):
         result.update(bench_sim(args.sim_runs))
     if args.what in ("nav", "all"):
-        result.update(bench_nav(args.trial_runs, args.trial_rtf))
+        result.update(bench_nav(args.trial_runs, args.trial_rtf, args.fleet_runs))
     if args.what == "formation":
         result.update(bench_formation(args.seeds, args.sizes))
     result["machine"] = machine()

@@ -48,7 +48,43 @@ def test_static_obstacles_of_the_trial_world():
 
 
 def test_summary_counts():
-    outcomes = [{"succeeded": True, "contacts": 0}, {"succeeded": False, "contacts": 2},
-                {"succeeded": True, "contacts": 1}]
-    assert nav_trial.summary(outcomes, 123.456, 7.89) == {
-        "runs": 3, "succeeded": 2, "contacts": 3, "sim_seconds": 123.5, "wall_seconds": 7.9}
+    outcomes = [{"succeeded": True, "sim_seconds": 10.0}, {"succeeded": False, "sim_seconds": 150.0},
+                {"succeeded": True, "sim_seconds": 31.0}]
+    assert nav_trial.summary(outcomes, 3, 123.456, 7.89, robots=3) == {
+        "runs": 3, "succeeded": 2, "contacts": 3, "sim_seconds": 123.5, "wall_seconds": 7.9, "robots": 3,
+        "mean_goal_s": 20.5}  # the failed run's time does not count
+    assert nav_trial.summary([{"succeeded": False, "sim_seconds": 150.0}], 0, 1.0, 1.0)["mean_goal_s"] is None
+
+
+def test_judge_needs_the_action_the_time_and_the_true_position():
+    goal = (2.0, 3.0)
+    assert nav_trial.judge(True, 40.0, 150.0, (2.05, 3.05), goal, 0.1) == (True, "")
+    # the nav node said SUCCEEDED, but the ground truth is 0.15 m off: its localization was wrong
+    ok, why = nav_trial.judge(True, 40.0, 150.0, (2.15, 3.0), goal, 0.1)
+    assert not ok and "0.150 m" in why
+    assert nav_trial.judge(True, 40.0, 150.0, (2.15, 3.0), goal, 0.2)[0]  # the tolerance given is used
+    assert nav_trial.judge(True, 150.0, 150.0, goal, goal, 0.1)[0]  # ends at the timeout: still in time
+    assert nav_trial.judge(True, 150.1, 150.0, goal, goal, 0.1) == (False, "timeout")  # ends after it
+    assert nav_trial.judge(False, 40.0, 150.0, goal, goal, 0.1) == (False, "not SUCCEEDED")
+
+
+def test_split_runs():
+    assert nav_trial.split_runs(100, 3) == [34, 33, 33]
+    assert nav_trial.split_runs(9, 3) == [3, 3, 3]
+    assert nav_trial.split_runs(100, 1) == [100]
+    assert sum(nav_trial.split_runs(7, 4)) == 7
+
+
+def test_pick_goal_keeps_away_from_the_other_robots_goals():
+    planned = (1.0, 1.0, 0.5)
+    spares = iter([(1.5, 1.0, 0.1), (3.0, 1.0, 0.2), (5.0, 5.0, 0.3)])
+    assert nav_trial.pick_goal(planned, spares, [(4.0, 4.0)], 1.0) == (planned, False)
+    # planned is 0.5 m from a claim: the first spare that is 1 m clear of every claim replaces it
+    goal, replaced = nav_trial.pick_goal(planned, spares, [(1.0, 1.5), (3.5, 1.0)], 1.0)
+    assert replaced and goal == (5.0, 5.0, 0.3)
+    try:
+        nav_trial.pick_goal(planned, iter([]), [(1.0, 1.0)], 1.0)
+    except ValueError as e:
+        assert "1.00 m" in str(e)
+    else:
+        raise AssertionError("no ValueError when the spares run out")
