@@ -6,7 +6,7 @@
  * Ranges follow REP-117: a beam with no return within range_max reads +Inf; a return closer
  * than range_min reads -Inf.
  *
- * How it is fast (details in raycast.cpp):
+ * How it is fast (details in src/raycast/: grid_walk.cpp, wall_sweep.cpp, scan.cpp):
  * - whole scans against the walls are an angular sweep: at map load the boundary between free
  *   and occupied cells is cut into axis-aligned wall faces, bucketed in tiles; a scan visits
  *   the faces in range that face the sensor, and each face tests only the beams inside the
@@ -74,7 +74,7 @@ public:
 
   /// @brief Cast n rays from (x, y) [m] along the unit vectors (dir_x[i], dir_y[i]); ranges[i]
   ///        gets what castDirection() would return. Faster per ray than n single casts: the
-  ///        rays are traced interleaved (see raycast.cpp).
+  ///        rays are traced interleaved (see grid_walk.cpp).
   /// @throws std::invalid_argument for a direction that is not finite
   void castFan(double x, double y, const double* dir_x, const double* dir_y, int n, double max_range,
                double* ranges) const;
@@ -141,10 +141,10 @@ private:
   /// The same counting only the walls ahead of a ray heading into quadrant q (bit 0: dir_x < 0,
   /// bit 1: dir_y < 0): a ray heading up and right never meets a wall below or left of its
   /// cell, so it may jump farther. These are what the ray tracing reads: (size_x + 2) x
-  /// (size_y + 2) with a border of free cells, wall cells marked 0 (see raycast.cpp).
+  /// (size_y + 2) with a border of free cells, wall cells marked 0 (see grid_walk.cpp).
   std::array<std::vector<uint8_t>, 4> quadrant_clearance_;
 
-  /// Wall faces by tile (kTileCells square, see raycast.cpp) and by side, the way the free
+  /// Wall faces by tile (kTileCells square, see wall_sweep.cpp) and by side, the way the free
   /// side looks (0: -x, 1: +x, 2: -y, 3: +y): tile t's faces of side s are
   /// tile_faces_[tile_start_[4 t + s] .. tile_start_[4 t + s + 1]). A face crossing tiles is
   /// copied into each.

@@ -1,0 +1,149 @@
+/**
+ * @file sensors.cpp
+ * @brief Sensor timers, the laser scan (walls and bodies), and handing samples to the listener,
+ *        at once or after a latency fault's delay. See sensors.h.
+ */
+#include "sensors.h"
+
+#include "odometry.h"
+
+#include <deque>
+
+namespace mbot_sim
+{
+namespace detail
+{
+namespace
+{
+/// True when a timer with `next` is due at `now`; then `next` moves on by one period.
+bool due(double now, double& next, double period)
+{
+  if (now + kTimeEpsilon < next) return false;
+  next += period;
+  if (next <= now) next = now + period;  // after a long pause of the timer: no burst
+  return true;
+}
+
+/// Hand over the samples a latency fault held back whose time has come (a silenced robot's
+/// are dropped).
+template <class Sample>
+void releasePending(Robot& r, double now, SensorListener* listener, std::deque<Pending<Sample>>& queue,
+                    void (SensorListener::*deliver)(int, const Sample&))
+{
+  while (!queue.empty() && queue.front().release <= now + kTimeEpsilon)
+  {
+    if (listener && !r.faults.silenced) (listener->*deliver)(r.id, queue.front().sample);
+    queue.pop_front();
+  }
+}
+}  // namespace
+
+Sensors::Sensors() : shapes_(4.0) {}
+
+void Sensors::run(double now, const NoiseConfig& noise, SensorListener* listener,
+                  const std::vector<std::unique_ptr<Robot>>& robots,
+                  const std::vector<std::unique_ptr<Obstacle>>& obstacles,
+                  const std::vector<std::unique_ptr<Mover>>& movers)
+{
+  bool shapes_built = false;  // only when some laser is due
+  for (const auto& robot : robots)
+  {
+    Robot& r = *robot;
+    if (due(now, r.next_ground_truth, r.ground_truth_period) && listener)
+    {
+      GroundTruthSample gt;
+      gt.stamp = now;
+      gt.pose = r.pose;
+      gt.twist = r.velocity;
+      listener->onGroundTruth(r.id, gt);
+    }
+    const bool silenced = r.faults.silenced;
+    if (due(now, r.next_odom, r.odom_period) && !silenced)
+    {
+      OdometrySample odom;
+      odom.stamp = now;
+      odom.pose = r.odom;
+      odom.twist = r.odom_twist;
+      r.joints.stamp = now;
+      if (delayed(r))
+      {
+        const double release = releaseTime(r, now);
+        r.pending_odom.push_back({release, odom});
+        r.pending_joints.push_back({release, r.joints});
+      }
+      else if (listener)
+      {
+        listener->onOdometry(r.id, odom);
+        listener->onJointState(r.id, r.joints);
+      }
+    }
+    if (due(now, r.next_scan, r.scan_period) && !silenced)
+    {
+      if (!shapes_built)
+      {
+        buildShapes(robots, obstacles, movers);
+        shapes_built = true;
+      }
+      measureScan(r, now, noise);
+      if (delayed(r))
+        r.pending_scans.push_back({releaseTime(r, now), r.scan});
+      else if (listener)
+        listener->onScan(r.id, r.scan);
+    }
+    releasePending(r, now, listener, r.pending_odom, &SensorListener::onOdometry);
+    releasePending(r, now, listener, r.pending_joints, &SensorListener::onJointState);
+    releasePending(r, now, listener, r.pending_scans, &SensorListener::onScan);
+  }
+}
+
+void Sensors::buildShapes(const std::vector<std::unique_ptr<Robot>>& robots,
+                          const std::vector<std::unique_ptr<Obstacle>>& obstacles,
+                          const std::vector<std::unique_ptr<Mover>>& movers)
+{
+  shapes_.clear();
+  for (const auto& o : obstacles) addShape(o->outline, o->pose, -1);
+  for (const auto& m : movers) addShape(m->outline, m->pose, -1);
+  for (const auto& r : robots) addShape(r->outline, r->pose, r->id);
+}
+
+void Sensors::addShape(const Outline& outline, const Pose2D& pose, int owner)
+{
+  const Pose2D p = outlinePose(outline, pose);
+  if (outline.is_box)
+  {
+    OrientedBox b;
+    b.x = p.x;
+    b.y = p.y;
+    b.yaw = p.theta;
+    b.half_length = outline.half_length;
+    b.half_width = outline.half_width;
+    b.owner = owner;
+    shapes_.addBox(b);
+  }
+  else
+  {
+    Circle c;
+    c.x = p.x;
+    c.y = p.y;
+    c.radius = outline.radius;
+    c.owner = owner;
+    shapes_.addCircle(c);
+  }
+}
+
+void Sensors::measureScan(Robot& r, double now, const NoiseConfig& noise)
+{
+  const auto& laser = r.model.laser;
+  ScanSpec& spec = r.scan_spec;
+  const Point2D mount = mbot_common::transformPoint(r.pose, laser.mount_x, laser.mount_y);
+  spec.x = mount.x;
+  spec.y = mount.y;
+  spec.yaw = r.pose.theta + laser.mount_yaw;
+  castScan(grid_, shapes_, spec, r.scan.ranges);
+  rays_cast_ += static_cast<unsigned long long>(spec.beams);
+  r.scan.stamp = now;
+  addLaserNoise(r, noise);
+}
+
+}  // namespace detail
+}  // namespace mbot_sim

@@ -1,0 +1,45 @@
+/**
+ * @file sensors.h
+ * @brief (private to the world) The sensors of every robot, each on its own timer in sim time:
+ *        ground truth, odometry with joint states, and the laser (cast against the walls and
+ *        the bodies, raycast.h). Samples go to the SensorListener at once or, with a latency
+ *        fault, when they are due.
+ */
+#pragma once
+
+#include "bodies.h"
+
+namespace mbot_sim
+{
+namespace detail
+{
+class Sensors
+{
+public:
+  Sensors();
+  /// The walls the lasers see (the map's occupied cells).
+  void setWalls(GridRaycaster grid) { grid_ = std::move(grid); }
+
+  /// After a step at sim time `now`: every robot's sensors that are due measure, and samples
+  /// held back by a latency fault that are due now are handed over.
+  void run(double now, const NoiseConfig& noise, SensorListener* listener,
+           const std::vector<std::unique_ptr<Robot>>& robots, const std::vector<std::unique_ptr<Obstacle>>& obstacles,
+           const std::vector<std::unique_ptr<Mover>>& movers);
+
+  unsigned long long raysCast() const { return rays_cast_; }
+
+private:
+  /// The shapes the lasers see besides the walls, where the bodies are now.
+  void buildShapes(const std::vector<std::unique_ptr<Robot>>& robots,
+                   const std::vector<std::unique_ptr<Obstacle>>& obstacles,
+                   const std::vector<std::unique_ptr<Mover>>& movers);
+  void addShape(const Outline& outline, const Pose2D& pose, int owner);
+  void measureScan(Robot& r, double now, const NoiseConfig& noise);
+
+  GridRaycaster grid_;
+  ShapeSet shapes_;
+  unsigned long long rays_cast_ = 0;
+};
+
+}  // namespace detail
+}  // namespace mbot_sim
