@@ -5,7 +5,7 @@ the other, in a world of its own roslaunch; count the goals reached and the cont
 
 prints ``{"runs": N, "succeeded": N, "contacts": N, "sim_seconds": X, "wall_seconds": X}``.
 
-- The world defaults to test/worlds/nav_office.world.yaml (the office with one robot, robot_0,
+- The world defaults to test/fixtures/worlds/nav_office.world.yaml (the office with one robot, robot_0,
   and the crate). The program starts ``fleet_navigation.launch`` on a free private port (its own
   master) and stops it at the end.
 - Goals are drawn with numpy's RandomState(seed) among the map cells whose clearance (distance to
@@ -37,9 +37,9 @@ ROBOT_RADIUS = 0.15  # [m] mbot's footprint; the clearance default keeps goals w
 
 
 def default_world():
-    """test/worlds/nav_office.world.yaml of this package (source tree)."""
+    """test/fixtures/worlds/nav_office.world.yaml of this package (source tree)."""
     here = os.path.dirname(os.path.abspath(__file__))  # src/mbot_navigation
-    return os.path.normpath(os.path.join(here, "..", "..", "test", "worlds", "nav_office.world.yaml"))
+    return os.path.normpath(os.path.join(here, "..", "..", "test", "fixtures", "worlds", "nav_office.world.yaml"))
 
 
 def static_obstacles(world_path):

@@ -23,7 +23,7 @@ def write(tmp_path, name, text):
 def test_finds_the_workspace_maps_and_resolves_names():
     assert find_maps_directory(PACKAGE_DIR) == MAPS_DIR
     assert resolve_world_path("office", MAPS_DIR) == os.path.join(MAPS_DIR, "office.world.yaml")
-    test_world = os.path.join(PACKAGE_DIR, "test", "worlds", "nav_office.world.yaml")
+    test_world = os.path.join(PACKAGE_DIR, "test", "fixtures", "worlds", "nav_office.world.yaml")
     assert resolve_world_path(test_world, None) == test_world
     with pytest.raises(WorldFileError, match="no such file"):
         resolve_world_path("no_such_world", MAPS_DIR)
