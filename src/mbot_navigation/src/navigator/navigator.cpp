@@ -35,25 +35,26 @@ const char* toString(NavState state)
   return "?";
 }
 
-Navigator::Navigator(const NavigatorConfig& config, const DwaConfig& dwa, std::unique_ptr<GlobalPlanner> planner,
-                     std::vector<std::unique_ptr<RecoveryBehavior>> recoveries)
+Navigator::Navigator(const NavigatorConfig& config, std::unique_ptr<LocalPlanner> local_planner,
+                     std::unique_ptr<GlobalPlanner> planner, std::vector<std::unique_ptr<RecoveryBehavior>> recoveries)
     : config_(config),
       planner_(std::move(planner)),
-      dwa_(std::make_unique<DwaPlanner>(dwa)),
+      local_planner_(std::move(local_planner)),
       recoveries_(std::move(recoveries))
 {
   if (!planner_) throw std::invalid_argument("Navigator: no global planner");
+  if (!local_planner_) throw std::invalid_argument("Navigator: no local planner");
   if (!(config.planner_patience >= 0.0) || !(config.controller_patience >= 0.0) || !(config.planner_frequency >= 0.0) ||
       !(config.oscillation_timeout >= 0.0))
     throw std::invalid_argument(
         "Navigator: planner_patience, controller_patience, planner_frequency and oscillation_timeout must be >= 0");
 }
 
-void Navigator::setLocalPlannerConfig(const DwaConfig& dwa)
+void Navigator::setLocalPlanner(std::unique_ptr<LocalPlanner> local_planner)
 {
-  auto planner = std::make_unique<DwaPlanner>(dwa);  // validates
-  if (!plan_.empty()) planner->setPlan(plan_);
-  dwa_ = std::move(planner);
+  if (!local_planner) throw std::invalid_argument("Navigator: no local planner");
+  if (!plan_.empty()) local_planner->setPlan(plan_);
+  local_planner_ = std::move(local_planner);
 }
 
 void Navigator::setGoal(const Pose2D& goal, double now)
@@ -132,7 +133,7 @@ bool Navigator::replan(const Costmap2D& global_costmap, const Pose2D& pose, doub
     return false;
   }
   plan_ = std::move(result.path);
-  dwa_->setPlan(plan_);
+  local_planner_->setPlan(plan_);
   last_plan_time_ = now;
   return true;
 }
@@ -239,9 +240,9 @@ NavCycleResult Navigator::control(double now, const Pose2D& pose, const Twist2D&
 
   // 1. Replan when the plan ahead became impassable, or periodically. Poses under the robot's own
   //    footprint do not count: the robot may stand close to something that it is leaving.
-  const std::vector<Pose2D>& ahead = dwa_->plan();
+  const std::vector<Pose2D>& ahead = local_planner_->plan();
   size_t from = 0;
-  const double own = dwa_->config().footprint_radius;
+  const double own = local_planner_->footprintRadius();
   while (from < ahead.size() && std::hypot(ahead[from].x - pose.x, ahead[from].y - pose.y) <= own) ++from;
   const bool blocked = firstBlockedPose(global_costmap, ahead, from, config_.allow_unknown) >= 0;
   const bool periodic = !blocked && config_.planner_frequency > 0.0 &&
@@ -265,7 +266,7 @@ NavCycleResult Navigator::control(double now, const Pose2D& pose, const Twist2D&
   }
 
   // 2. Arrived?
-  if (dwa_->isGoalReached(pose, velocity)) return finish(NavOutcome::SUCCEEDED, "");
+  if (local_planner_->isGoalReached(pose, velocity)) return finish(NavOutcome::SUCCEEDED, "");
 
   // 3. Oscillation: not moving for too long.
   if (config_.oscillation_timeout > 0.0 && now - last_progress_time_ > config_.oscillation_timeout)
@@ -278,7 +279,7 @@ NavCycleResult Navigator::control(double now, const Pose2D& pose, const Twist2D&
 
   // 4. The local planner.
   Twist2D cmd;
-  const LocalPlanResult local = dwa_->computeVelocityCommands(pose, velocity, local_costmap, cmd);
+  const LocalPlanResult local = local_planner_->computeVelocityCommands(pose, velocity, local_costmap, cmd);
   if (local.ok)
   {
     last_valid_control_ = now;
@@ -290,9 +291,10 @@ NavCycleResult Navigator::control(double now, const Pose2D& pose, const Twist2D&
   last_error_ = "local planner: " + local.error;
   if (now - last_valid_control_ > config_.controller_patience)
   {
-    char buf[96];
+    char buf[128];
     std::snprintf(buf, sizeof(buf),
-                  "the local planner (DWA) found no valid velocity command for %.1f s: ", config_.controller_patience);
+                  "the local planner (%s) found no valid velocity command for %.1f s: ", local_planner_->name().c_str(),
+                  config_.controller_patience);
     return recover(buf + local.error, input);
   }
   // As move_base: stand still and plan again (the plan may be what the local planner cannot follow).

@@ -149,14 +149,6 @@ void readRobotsLayer(StrictParams& p, const std::string& prefix, CostmapRosSetti
   s.robots_scan_margin = p.getDouble(prefix + "scan_margin", s.robots_scan_margin);
 }
 
-enum class LayerKind
-{
-  STATIC,
-  OBSTACLE,
-  INFLATION,
-  ROBOTS
-};
-
 /// costmap_2d's `plugins` list: [{name, type}, ...] -> the layers, each read from its namespace.
 void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, int& prediction_cost,
                  ParamWarnings& w)
@@ -230,6 +222,7 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
     }
     lp.checkNoUnknown();
   }
+  s.layer_order = seen;  // built in the listed order
   if (!s.inflation)
     w.push_back("parameter " + param + ": no inflation layer, so nothing keeps the robot's radius off obstacles");
   for (const std::string& key : kFlatLayerKeys)
@@ -363,18 +356,31 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
     : name_(name), settings_(settings), tf_(tf)
 {
   layered_ = std::make_unique<LayeredCostmap>(settings.costmap);
-  if (settings.static_map)
-    static_layer_ =
-        static_cast<StaticLayer*>(&layered_->addLayer(std::make_unique<StaticLayer>(settings.static_layer)));
-  if (!settings.scan_topic.empty())
-    obstacle_layer_ =
-        static_cast<ObstacleLayer*>(&layered_->addLayer(std::make_unique<ObstacleLayer>(settings.obstacle_layer)));
-  if (settings.robots_layer)
-    robots_layer_ = static_cast<RobotsLayer*>(&layered_->addLayer(std::make_unique<RobotsLayer>(settings.robots)));
-  // Last: inflate everything below, teammates included.
-  if (settings.inflation)
-    inflation_layer_ =
-        static_cast<InflationLayer*>(&layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer)));
+  // Bottom to top as configured; the default puts inflation last, so that it inflates everything
+  // below it, teammates included.
+  for (const LayerKind kind : settings.layer_order) switch (kind)
+    {
+      case LayerKind::STATIC:
+        if (settings.static_map && !static_layer_)
+          static_layer_ =
+              static_cast<StaticLayer*>(&layered_->addLayer(std::make_unique<StaticLayer>(settings.static_layer)));
+        break;
+      case LayerKind::OBSTACLE:
+        if (!settings.scan_topic.empty() && !obstacle_layer_)
+          obstacle_layer_ = static_cast<ObstacleLayer*>(
+              &layered_->addLayer(std::make_unique<ObstacleLayer>(settings.obstacle_layer)));
+        break;
+      case LayerKind::ROBOTS:
+        if (settings.robots_layer && !robots_layer_)
+          robots_layer_ =
+              static_cast<RobotsLayer*>(&layered_->addLayer(std::make_unique<RobotsLayer>(settings.robots)));
+        break;
+      case LayerKind::INFLATION:
+        if (settings.inflation && !inflation_layer_)
+          inflation_layer_ = static_cast<InflationLayer*>(
+              &layered_->addLayer(std::make_unique<InflationLayer>(settings.inflation_layer)));
+        break;
+    }
 
   // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
   if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);

@@ -352,4 +352,94 @@ NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& privat
   return out;
 }
 
+DWAPlannerConfig toReconfigure(const DwaConfig& d)
+{
+  DWAPlannerConfig c;
+  c.max_vel_trans = d.max_vel_trans;
+  c.min_vel_trans = d.min_vel_trans;
+  c.max_vel_x = d.max_vel_x;
+  c.min_vel_x = d.min_vel_x;
+  c.max_vel_y = d.max_vel_y;
+  c.min_vel_y = d.min_vel_y;
+  c.max_vel_theta = d.max_vel_theta;
+  c.min_vel_theta = d.min_vel_theta;
+  c.acc_lim_x = d.acc_lim_x;
+  c.acc_lim_y = d.acc_lim_y;
+  c.acc_lim_theta = d.acc_lim_theta;
+  c.trans_stopped_vel = d.trans_stopped_vel;
+  c.theta_stopped_vel = d.theta_stopped_vel;
+  c.xy_goal_tolerance = d.xy_goal_tolerance;
+  c.yaw_goal_tolerance = d.yaw_goal_tolerance;
+  c.latch_xy_goal_tolerance = d.latch_xy_goal_tolerance;
+  c.sim_time = d.sim_time;
+  c.sim_granularity = d.sim_granularity;
+  c.angular_sim_granularity = d.angular_sim_granularity;
+  c.vx_samples = d.vx_samples;
+  c.vy_samples = d.vy_samples;
+  c.vth_samples = d.vth_samples;
+  c.path_distance_bias = d.path_distance_bias;
+  c.goal_distance_bias = d.goal_distance_bias;
+  c.occdist_scale = d.occdist_scale;
+  c.twirling_scale = d.twirling_scale;
+  c.forward_point_distance = d.forward_point_distance;
+  c.oscillation_reset_dist = d.oscillation_reset_dist;
+  c.oscillation_reset_angle = d.oscillation_reset_angle;
+  c.prune_plan = d.prune_plan;
+  return c;
+}
+
+DwaConfig fromReconfigure(const DWAPlannerConfig& c, const DwaConfig& base)
+{
+  DwaConfig d = base;
+  d.max_vel_trans = c.max_vel_trans;
+  d.min_vel_trans = c.min_vel_trans;
+  d.max_vel_x = c.max_vel_x;
+  d.min_vel_x = c.min_vel_x;
+  d.max_vel_y = c.max_vel_y;
+  d.min_vel_y = c.min_vel_y;
+  d.max_vel_theta = c.max_vel_theta;
+  d.min_vel_theta = c.min_vel_theta;
+  d.acc_lim_x = c.acc_lim_x;
+  d.acc_lim_y = c.acc_lim_y;
+  d.acc_lim_theta = c.acc_lim_theta;
+  d.trans_stopped_vel = c.trans_stopped_vel;
+  d.theta_stopped_vel = c.theta_stopped_vel;
+  d.xy_goal_tolerance = c.xy_goal_tolerance;
+  d.yaw_goal_tolerance = c.yaw_goal_tolerance;
+  d.latch_xy_goal_tolerance = c.latch_xy_goal_tolerance;
+  d.sim_time = c.sim_time;
+  d.sim_granularity = c.sim_granularity;
+  d.angular_sim_granularity = c.angular_sim_granularity;
+  d.vx_samples = c.vx_samples;
+  d.vy_samples = c.vy_samples;
+  d.vth_samples = c.vth_samples;
+  d.path_distance_bias = c.path_distance_bias;
+  d.goal_distance_bias = c.goal_distance_bias;
+  d.occdist_scale = c.occdist_scale;
+  d.twirling_scale = c.twirling_scale;
+  d.forward_point_distance = c.forward_point_distance;
+  d.oscillation_reset_dist = c.oscillation_reset_dist;
+  d.oscillation_reset_angle = c.oscillation_reset_angle;
+  d.prune_plan = c.prune_plan;
+  return d;
+}
+
+InflationConfig toReconfigure(const InflationLayerConfig& i)
+{
+  InflationConfig c;
+  c.inflation_radius = i.inflation_radius;
+  c.cost_scaling_factor = i.cost_scaling_factor;
+  c.inflate_unknown = i.inflate_unknown;
+  return c;
+}
+
+InflationLayerConfig fromReconfigure(const InflationConfig& c)
+{
+  InflationLayerConfig i;
+  i.inflation_radius = c.inflation_radius;
+  i.cost_scaling_factor = c.cost_scaling_factor;
+  i.inflate_unknown = c.inflate_unknown;
+  return i;
+}
+
 }  // namespace mbot_navigation

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <regex>
 #include <stdexcept>
 
 #include <ros/package.h>
@@ -10,10 +9,11 @@
 #include <tf2/utils.h>
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
-#include "mbot_description/robot_model.h"
 #include <mbot_common/ros_edge.h>
 #include "mbot_navigation/ros/move_base_params.h"
+#include "mbot_navigation/global_planner/goal_tolerance.h"
 #include "mbot_navigation/global_planner/planner_factory.h"
+#include "mbot_navigation/local_planner/dwa_planner.h"
 
 namespace mbot_navigation
 {
@@ -32,102 +32,16 @@ geometry_msgs::PoseStamped toPoseStamped(const Pose2D& p, const std::string& fra
 }  // namespace
 
 // =============================================================================================
-// TeammateTracker
-
-TeammateTracker::TeammateTracker(tf2_ros::Buffer& tf, const std::string& self, const std::string& global_frame,
-                                 Source source, const std::vector<std::string>& names, double timeout,
-                                 std::function<double(const std::string&)> radius_of)
-    : tf_(tf),
-      self_(self),
-      global_frame_(global_frame),
-      source_(source),
-      timeout_(timeout),
-      radius_of_(std::move(radius_of))
-{
-  for (const std::string& name : names)
-    if (name != self_) track(name);
-}
-
-void TeammateTracker::track(const std::string& name)
-{
-  if (mates_.count(name)) return;
-  Mate& mate = mates_[name];
-  mate.radius = radius_of_(name);
-  ros::NodeHandle root;
-  const std::string topic = "/" + name + (source_ == Source::GROUND_TRUTH ? "/base_pose_ground_truth" : "/odom");
-  mate.sub = root.subscribe<nav_msgs::Odometry>(
-      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; });
-  ROS_INFO("teammate %s: from %s (radius %.2f m)", name.c_str(), topic.c_str(), mate.radius);
-}
-
-void TeammateTracker::discover()
-{
-  ros::master::V_TopicInfo topics;
-  if (!ros::master::getTopics(topics)) return;
-  static const std::regex odom_topic("^/([^/]+)/odom$");
-  for (const ros::master::TopicInfo& t : topics)
-  {
-    std::smatch m;
-    if (t.datatype != "nav_msgs/Odometry" || !std::regex_match(t.name, m, odom_topic)) continue;
-    if (m[1] != self_) track(m[1]);
-  }
-}
-
-std::vector<std::string> TeammateTracker::names() const
-{
-  std::vector<std::string> out;
-  for (const auto& kv : mates_) out.push_back(kv.first);
-  return out;
-}
-
-std::vector<TeammateState> TeammateTracker::states(const ros::Time& now) const
-{
-  std::vector<TeammateState> out;
-  for (const auto& kv : mates_)
-  {
-    const nav_msgs::Odometry::ConstPtr& msg = kv.second.last;
-    if (!msg || std::fabs((now - msg->header.stamp).toSec()) > timeout_) continue;
-    TeammateState s;
-    s.name = kv.first;
-    s.radius = kv.second.radius;
-    s.vx = msg->twist.twist.linear.x;
-    s.vy = msg->twist.twist.linear.y;
-    s.wz = msg->twist.twist.angular.z;
-    if (source_ == Source::GROUND_TRUTH)
-    {
-      s.pose = mbot_common::toPose2D(msg->pose.pose);
-    }
-    else
-    {
-      try
-      {
-        s.pose = mbot_common::toPose2D(
-            tf_.lookupTransform(global_frame_, kv.first + "/base_footprint", ros::Time(0)).transform);
-      }
-      catch (const tf2::TransformException&)
-      {
-        continue;  // no pose for it yet
-      }
-    }
-    out.push_back(s);
-  }
-  return out;
-}
-
-// =============================================================================================
 // NavNode: set-up
 
 NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), private_nh_(private_nh)
 {
-  description_dir_ = ros::package::getPath("mbot_description");
-  if (description_dir_.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
+  const std::string description_dir = ros::package::getPath("mbot_description");
+  if (description_dir.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
   ParamWarnings warnings;
-  const NavParams params = readNavParams(nh_, private_nh_, description_dir_, warnings);
+  const NavParams params = readNavParams(nh_, private_nh_, description_dir, warnings);
   for (const std::string& w : warnings) ROS_WARN("%s", w.c_str());
   robot_ = params.robot;
-  own_model_ = params.model;
-  own_radius_ = params.footprint_radius;
-  model_radius_[own_model_] = own_radius_;
   controller_patience_ = params.nav.controller_patience;
   const CostmapRosSettings& global_settings = params.global_costmap;
   const CostmapRosSettings& local_settings = params.local_costmap;
@@ -173,12 +87,14 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   back_up.footprint_radius = local_settings.costmap.robot_radius;
   back_up.speed = std::min(back_up.speed, -params.model_min_vel_x);  // a robot that cannot reverse does not
   if (back_up.distance > 0.0 && back_up.speed > 0.0) recoveries.push_back(std::make_unique<BackUpRecovery>(back_up));
-  navigator_ = std::make_unique<Navigator>(params.nav, dwa, std::move(global_planner), std::move(recoveries));
+  dwa_config_ = dwa;
+  navigator_ = std::make_unique<Navigator>(params.nav, std::make_unique<DwaPlanner>(dwa), std::move(global_planner),
+                                           std::move(recoveries));
 
   teammates_ = std::make_unique<TeammateTracker>(
       *tf_, robot_, global_frame_,
       params.robots_source == "odom" ? TeammateTracker::Source::ODOM : TeammateTracker::Source::GROUND_TRUTH,
-      params.robots, params.robots_timeout, [this](const std::string& name) { return teammateRadius(name); });
+      params.robots, params.robots_timeout, TeammateRadii(description_dir, params.model, params.footprint_radius));
   if (params.robots.empty())
   {
     teammates_->discover();
@@ -205,34 +121,8 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   ROS_INFO(
       "%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
       "waiting for the map and the robot's pose",
-      private_nh_.getNamespace().c_str(), robot_.c_str(), own_model_.c_str(), own_radius_, global_planner_name.c_str(),
-      controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str());
-}
-
-double NavNode::teammateRadius(const std::string& name)
-{
-  // The simulator lists its robots' models in /stage/robots ([{name, model}]); else assume ours.
-  std::string model = own_model_;
-  XmlRpc::XmlRpcValue list;
-  if (ros::param::getCached("/stage/robots", list) && list.getType() == XmlRpc::XmlRpcValue::TypeArray)
-    for (int i = 0; i < list.size(); ++i)
-      if (list[i].getType() == XmlRpc::XmlRpcValue::TypeStruct && list[i].hasMember("name") &&
-          list[i].hasMember("model") && static_cast<std::string>(list[i]["name"]) == name)
-        model = static_cast<std::string>(list[i]["model"]);
-  auto it = model_radius_.find(model);
-  if (it != model_radius_.end()) return it->second;
-  double radius = own_radius_;
-  try
-  {
-    radius = mbot_description::loadRobotModel(description_dir_, model).footprint_radius;
-  }
-  catch (const std::exception& e)
-  {
-    ROS_WARN("teammate %s: cannot load model '%s' (%s); assuming radius %.2f m", name.c_str(), model.c_str(), e.what(),
-             radius);
-  }
-  model_radius_[model] = radius;
-  return radius;
+      private_nh_.getNamespace().c_str(), robot_.c_str(), params.model.c_str(), params.footprint_radius,
+      global_planner_name.c_str(), controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str());
 }
 
 // =============================================================================================
@@ -379,52 +269,17 @@ void NavNode::startReconfigureServers()
   // setCallback(), whose first call then applies the same values.
   dwa_server_ = std::make_unique<dynamic_reconfigure::Server<DWAPlannerConfig>>(
       reconfigure_mutex_, ros::NodeHandle(private_nh_, "DWAPlannerROS"));
-  const DwaConfig& d = navigator_->localPlanner().config();
-  DWAPlannerConfig c;
-  c.max_vel_trans = d.max_vel_trans;
-  c.min_vel_trans = d.min_vel_trans;
-  c.max_vel_x = d.max_vel_x;
-  c.min_vel_x = d.min_vel_x;
-  c.max_vel_y = d.max_vel_y;
-  c.min_vel_y = d.min_vel_y;
-  c.max_vel_theta = d.max_vel_theta;
-  c.min_vel_theta = d.min_vel_theta;
-  c.acc_lim_x = d.acc_lim_x;
-  c.acc_lim_y = d.acc_lim_y;
-  c.acc_lim_theta = d.acc_lim_theta;
-  c.trans_stopped_vel = d.trans_stopped_vel;
-  c.theta_stopped_vel = d.theta_stopped_vel;
-  c.xy_goal_tolerance = d.xy_goal_tolerance;
-  c.yaw_goal_tolerance = d.yaw_goal_tolerance;
-  c.latch_xy_goal_tolerance = d.latch_xy_goal_tolerance;
-  c.sim_time = d.sim_time;
-  c.sim_granularity = d.sim_granularity;
-  c.angular_sim_granularity = d.angular_sim_granularity;
-  c.vx_samples = d.vx_samples;
-  c.vy_samples = d.vy_samples;
-  c.vth_samples = d.vth_samples;
-  c.path_distance_bias = d.path_distance_bias;
-  c.goal_distance_bias = d.goal_distance_bias;
-  c.occdist_scale = d.occdist_scale;
-  c.twirling_scale = d.twirling_scale;
-  c.forward_point_distance = d.forward_point_distance;
-  c.oscillation_reset_dist = d.oscillation_reset_dist;
-  c.oscillation_reset_angle = d.oscillation_reset_angle;
-  c.prune_plan = d.prune_plan;
+  DWAPlannerConfig c = toReconfigure(dwa_config_);
   dwa_server_->updateConfig(c);
   dwa_server_->setCallback([this](DWAPlannerConfig& config, uint32_t) { onDwaReconfigure(config); });
 
   for (CostmapRos* costmap : {global_costmap_.get(), local_costmap_.get()})
   {
     if (!costmap->settings().inflation) continue;
-    const InflationLayerConfig& i = costmap->settings().inflation_layer;
     inflation_servers_.push_back(std::make_unique<dynamic_reconfigure::Server<InflationConfig>>(
         reconfigure_mutex_,
         ros::NodeHandle(private_nh_, costmap->name() + "/" + costmap->settings().inflation_layer_name)));
-    InflationConfig ic;
-    ic.inflation_radius = i.inflation_radius;
-    ic.cost_scaling_factor = i.cost_scaling_factor;
-    ic.inflate_unknown = i.inflate_unknown;
+    InflationConfig ic = toReconfigure(costmap->settings().inflation_layer);
     inflation_servers_.back()->updateConfig(ic);
     inflation_servers_.back()->setCallback(
         [this, costmap](InflationConfig& config, uint32_t) { onInflationReconfigure(*costmap, config); });
@@ -433,40 +288,11 @@ void NavNode::startReconfigureServers()
 
 void NavNode::onDwaReconfigure(DWAPlannerConfig& c)
 {
-  DwaConfig d = navigator_->localPlanner().config();  // keeps the footprint and the control rate
-  d.max_vel_trans = c.max_vel_trans;
-  d.min_vel_trans = c.min_vel_trans;
-  d.max_vel_x = c.max_vel_x;
-  d.min_vel_x = c.min_vel_x;
-  d.max_vel_y = c.max_vel_y;
-  d.min_vel_y = c.min_vel_y;
-  d.max_vel_theta = c.max_vel_theta;
-  d.min_vel_theta = c.min_vel_theta;
-  d.acc_lim_x = c.acc_lim_x;
-  d.acc_lim_y = c.acc_lim_y;
-  d.acc_lim_theta = c.acc_lim_theta;
-  d.trans_stopped_vel = c.trans_stopped_vel;
-  d.theta_stopped_vel = c.theta_stopped_vel;
-  d.xy_goal_tolerance = c.xy_goal_tolerance;
-  d.yaw_goal_tolerance = c.yaw_goal_tolerance;
-  d.latch_xy_goal_tolerance = c.latch_xy_goal_tolerance;
-  d.sim_time = c.sim_time;
-  d.sim_granularity = c.sim_granularity;
-  d.angular_sim_granularity = c.angular_sim_granularity;
-  d.vx_samples = c.vx_samples;
-  d.vy_samples = c.vy_samples;
-  d.vth_samples = c.vth_samples;
-  d.path_distance_bias = c.path_distance_bias;
-  d.goal_distance_bias = c.goal_distance_bias;
-  d.occdist_scale = c.occdist_scale;
-  d.twirling_scale = c.twirling_scale;
-  d.forward_point_distance = c.forward_point_distance;
-  d.oscillation_reset_dist = c.oscillation_reset_dist;
-  d.oscillation_reset_angle = c.oscillation_reset_angle;
-  d.prune_plan = c.prune_plan;
+  const DwaConfig d = fromReconfigure(c, dwa_config_);  // keeps the footprint and the control rate
   try
   {
-    navigator_->setLocalPlannerConfig(d);
+    navigator_->setLocalPlanner(std::make_unique<DwaPlanner>(d));  // DwaPlanner validates
+    dwa_config_ = d;
     ROS_INFO("%s/DWAPlannerROS: new settings (max_vel_x %.2f m/s, max_vel_theta %.2f rad/s, sim_time %.2f s)",
              private_nh_.getNamespace().c_str(), d.max_vel_x, d.max_vel_theta, d.sim_time);
   }
@@ -479,10 +305,7 @@ void NavNode::onDwaReconfigure(DWAPlannerConfig& c)
 
 void NavNode::onInflationReconfigure(CostmapRos& costmap, InflationConfig& c)
 {
-  InflationLayerConfig config;
-  config.inflation_radius = c.inflation_radius;
-  config.cost_scaling_factor = c.cost_scaling_factor;
-  config.inflate_unknown = c.inflate_unknown;
+  const InflationLayerConfig config = fromReconfigure(c);
   try
   {
     costmap.setInflation(config);
@@ -629,23 +452,10 @@ bool NavNode::onMakePlan(nav_msgs::GetPlan::Request& req, nav_msgs::GetPlan::Res
     ROS_WARN("%s: make_plan: %s", private_nh_.getNamespace().c_str(), error.c_str());
     return true;  // as move_base: an empty plan
   }
-  PlanResult plan = navigator_->makePlan(global_costmap_->costmap(), start, goal);
-  if (!plan.ok && req.tolerance > 0.0)
-  {
-    // As move_base: try goals around the requested one, nearest first, within `tolerance`.
-    const Costmap2D& cm = global_costmap_->costmap();
-    const double res_m = cm.resolution();
-    for (double r = res_m; r <= req.tolerance + 1e-9 && !plan.ok; r += res_m)
-      for (int k = 0; k < 16 && !plan.ok; ++k)
-      {
-        Pose2D g = goal;
-        g.x += r * std::cos(k * M_PI / 8.0);
-        g.y += r * std::sin(k * M_PI / 8.0);
-        unsigned mx, my;
-        if (!cm.worldToMap(g.x, g.y, mx, my) || cm.cost(mx, my) >= cost::INSCRIBED) continue;
-        plan = navigator_->makePlan(cm, start, g);
-      }
-  }
+  // As move_base: when the goal cannot be planned to, try goals around it within `tolerance`.
+  const Costmap2D& costmap = global_costmap_->costmap();
+  const PlanResult plan = planWithTolerance(costmap, goal, req.tolerance,
+                                            [&](const Pose2D& g) { return navigator_->makePlan(costmap, start, g); });
   if (!plan.ok)
   {
     ROS_WARN("%s: make_plan: %s", private_nh_.getNamespace().c_str(), plan.error.c_str());

@@ -3,10 +3,12 @@
 // its key; a key nobody knows is an error naming it; the plugins form picks the layers.
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
+#include <tf2_ros/buffer.h>
 
 #include "mbot_navigation/ros/move_base_params.h"
 
@@ -186,7 +188,65 @@ TEST(MoveBaseParams, PluginsPickTheLayers)
   catch (const std::runtime_error& e)
   {
     EXPECT_NE(std::string(e.what()).find("social_navigation_layers::ProxemicLayer"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'social'"), std::string::npos) << e.what();
   }
+}
+
+namespace
+{
+/// A plugins list of a robots layer and an inflation layer, in this order or the other.
+XmlRpc::XmlRpcValue robotsAndInflation(bool inflation_last)
+{
+  XmlRpc::XmlRpcValue list;
+  const int robots = inflation_last ? 0 : 1;
+  list[robots]["name"] = "robots";
+  list[robots]["type"] = "mbot_navigation::RobotsLayer";
+  list[1 - robots]["name"] = "inflation_layer";
+  list[1 - robots]["type"] = "costmap_2d::InflationLayer";
+  return list;
+}
+
+/// The cost at (x, y) [m] after one update with a teammate standing at (1, 0).
+uint8_t costNearATeammate(const CostmapRosSettings& settings, double x, double y)
+{
+  ros::NodeHandle nh("/order"), private_nh("/order/move_base");
+  tf2_ros::Buffer tf;
+  CostmapRos costmap("global_costmap", settings, nh, private_nh, tf);
+  TeammateState mate;
+  mate.name = "robot_1";
+  mate.pose = Pose2D{1.0, 0.0, 0.0};
+  mate.radius = 0.2;
+  costmap.setTeammates({mate});
+  costmap.update(Pose2D{0.0, 0.0, 0.0}, ros::Time(1.0));
+  unsigned mx, my;
+  EXPECT_TRUE(costmap.costmap().worldToMap(x, y, mx, my));
+  return costmap.costmap().cost(mx, my);
+}
+}  // namespace
+
+TEST(MoveBaseParams, LayersAreStackedInTheListedOrder)
+{
+  CostmapRosSettings d;
+  EXPECT_EQ(d.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::ROBOTS,
+                                                   LayerKind::INFLATION}));  // costmap_2d's pre-layer order
+  d.costmap.rolling_window = true;                                           // no map needed
+  d.costmap.width = d.costmap.height = 4.0;
+  d.costmap.robot_radius = 0.15;
+  ParamWarnings warnings;
+  ros::param::set("/order_last/global_costmap/plugins", robotsAndInflation(true));
+  ros::param::set("/order_first/global_costmap/plugins", robotsAndInflation(false));
+  const CostmapRosSettings last = readCostmapSettings(ros::NodeHandle("/order_last/global_costmap"), d, &warnings);
+  const CostmapRosSettings first = readCostmapSettings(ros::NodeHandle("/order_first/global_costmap"), d, &warnings);
+  EXPECT_EQ(last.layer_order, (std::vector<LayerKind>{LayerKind::ROBOTS, LayerKind::INFLATION}));
+  EXPECT_EQ(first.layer_order, (std::vector<LayerKind>{LayerKind::INFLATION, LayerKind::ROBOTS}));
+  ASSERT_TRUE(last.inflation && last.robots_layer && first.inflation && first.robots_layer);
+
+  // The teammate (radius 0.2 m, drawn 0.1 m bigger) is lethal either way; 0.5 m from its centre
+  // there is inflation only when the inflation layer is above the robots layer.
+  EXPECT_EQ(costNearATeammate(last, 1.0, 0.0), cost::LETHAL);
+  EXPECT_EQ(costNearATeammate(first, 1.0, 0.0), cost::LETHAL);
+  EXPECT_GT(costNearATeammate(last, 1.5, 0.0), cost::FREE);
+  EXPECT_EQ(costNearATeammate(first, 1.5, 0.0), cost::FREE);
 }
 
 TEST(MoveBaseParams, FootprintRadius)

@@ -15,6 +15,7 @@
 #include "mbot_navigation/navigator/navigator.h"
 #include "mbot_navigation/navigator/recovery.h"
 #include "mbot_navigation/costmap/static_layer.h"
+#include "mbot_navigation/local_planner/dwa_planner.h"
 #include "mbot_navigation/local_planner/trajectory_generator.h"
 
 using namespace mbot_navigation;
@@ -98,6 +99,8 @@ DwaConfig mbotDwa()
   c.footprint_radius = kRadius;
   return c;
 }
+
+std::unique_ptr<LocalPlanner> dwa() { return std::make_unique<DwaPlanner>(mbotDwa()); }
 
 std::vector<std::unique_ptr<RecoveryBehavior>> standardRecoveries(int* clears)
 {
@@ -334,7 +337,7 @@ TEST(Navigator, ReachesAGoalThroughADoor)
   StaticLayer* local_static = nullptr;
   auto local = localCostmap(occ, local_static);
   int clears = 0;
-  Navigator nav(NavigatorConfig(), mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav(NavigatorConfig(), dwa(), planner(), standardRecoveries(&clears));
   EXPECT_EQ(nav.state(), NavState::IDLE);
 
   const Pose2D goal{2.5, 2.0, kPi / 2};
@@ -370,7 +373,7 @@ TEST(Navigator, ReplansWhenThePlanIsBlocked)
   StaticLayer* local_static = nullptr;
   auto local = localCostmap(occ, local_static);
   int clears = 0;
-  Navigator nav(NavigatorConfig(), mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav(NavigatorConfig(), dwa(), planner(), standardRecoveries(&clears));
   nav.setGoal(Pose2D{2.5, -1.0, 0.0}, 0.0);
   Sim sim{nav, *global, *local, Pose2D{-2.5, -1.0, 0.0}};
   sim.run(0.5);
@@ -410,7 +413,7 @@ TEST(Navigator, AbortsAfterPatienceAndRecoveriesWithTheReason)
   auto local = localCostmap(occ, local_static);
   int clears = 0;
   NavigatorConfig config;
-  Navigator nav(config, mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav(config, dwa(), planner(), standardRecoveries(&clears));
   nav.setGoal(Pose2D{2.5, 2.0, 0.0}, 0.0);
   Sim sim{nav, *global, *local, Pose2D{-2.5, -2.0, 0.0}};
   ASSERT_EQ(sim.run(200.0), NavOutcome::ABORTED);
@@ -429,7 +432,7 @@ TEST(Navigator, AbortsAfterPatienceAndRecoveriesWithTheReason)
   NavigatorConfig no_recovery;
   no_recovery.recovery_behavior_enabled = false;
   no_recovery.planner_patience = 2.0;
-  Navigator nav2(no_recovery, mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav2(no_recovery, dwa(), planner(), standardRecoveries(&clears));
   nav2.setGoal(Pose2D{2.5, 2.0, 0.0}, 0.0);
   Sim sim2{nav2, *global, *local, Pose2D{-2.5, -2.0, 0.0}};
   ASSERT_EQ(sim2.run(50.0), NavOutcome::ABORTED);
@@ -444,7 +447,7 @@ TEST(Navigator, CancelStopsAndANewGoalReplaces)
   StaticLayer* local_static = nullptr;
   auto local = localCostmap(occ, local_static);
   int clears = 0;
-  Navigator nav(NavigatorConfig(), mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav(NavigatorConfig(), dwa(), planner(), standardRecoveries(&clears));
   nav.setGoal(Pose2D{2.5, 2.0, 0.0}, 0.0);
   Sim sim{nav, *global, *local, Pose2D{-2.5, -2.0, 0.0}};
   sim.run(3.0);
@@ -467,7 +470,7 @@ TEST(Navigator, PlansOutOfAnInflatedStart)
   const std::vector<int8_t> occ = roomsMap(true);
   auto global = globalCostmap(occ);
   int clears = 0;
-  Navigator nav(NavigatorConfig(), mbotDwa(), planner(), standardRecoveries(&clears));
+  Navigator nav(NavigatorConfig(), dwa(), planner(), standardRecoveries(&clears));
   // 0.075 m from the wall face at x = -0.1: inside the inscribed radius.
   const Pose2D start{-0.17, 2.0, 0.0};
   unsigned mx, my;

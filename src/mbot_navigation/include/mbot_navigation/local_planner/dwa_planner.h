@@ -21,32 +21,14 @@
 
 #include "mbot_navigation/costmap/costmap_2d.h"
 #include "mbot_navigation/local_planner/critics.h"
+#include "mbot_navigation/local_planner/local_planner.h"
 #include "mbot_navigation/local_planner/trajectory.h"
 #include "mbot_navigation/local_planner/trajectory_generator.h"
 
 namespace mbot_navigation
 {
-/// @brief What the local planner is doing in this cycle.
-enum class LocalPlannerState
-{
-  FOLLOWING,  ///< driving along the plan (sampled trajectories)
-  STOPPING,   ///< at the goal position, braking before the final rotation
-  ROTATING,   ///< at the goal position, turning in place to the goal yaw
-  ARRIVED,    ///< at the goal pose, braking to a standstill
-};
-
-/// @brief Outcome of one control cycle; `error` says why when `ok` is false.
-struct LocalPlanResult
-{
-  bool ok = false;
-  std::string error;  ///< e.g. "no valid trajectory: 60 samples, rejected by obstacle: 60"
-  LocalPlannerState state = LocalPlannerState::FOLLOWING;
-  Trajectory trajectory;  ///< the chosen trajectory (for the local_plan topic)
-  int samples = 0;        ///< trajectories simulated this cycle
-};
-
 /// @brief The DWA local planner (setPlan / computeVelocityCommands / isGoalReached).
-class DwaPlanner
+class DwaPlanner : public LocalPlanner
 {
 public:
   /// @throws std::invalid_argument when a parameter is out of range (DwaConfig::validate)
@@ -57,7 +39,7 @@ public:
 
   /// @brief A new global plan, in the frame of the costmaps given to computeVelocityCommands.
   ///        Clears the goal latch and the oscillation flags.
-  void setPlan(const std::vector<Pose2D>& plan);
+  void setPlan(const std::vector<Pose2D>& plan) override;
 
   /**
    * @brief One control cycle.
@@ -69,15 +51,17 @@ public:
    *         the costmap, every sample rejected...); the caller then runs its recoveries
    */
   LocalPlanResult computeVelocityCommands(const Pose2D& robot_pose, const Twist2D& robot_velocity,
-                                          const Costmap2D& costmap, Twist2D& cmd);
+                                          const Costmap2D& costmap, Twist2D& cmd) override;
 
   /// @brief True when the robot is within both goal tolerances and stopped
   ///        (|v| <= trans_stopped_vel, |omega| <= theta_stopped_vel).
-  bool isGoalReached(const Pose2D& robot_pose, const Twist2D& robot_velocity) const;
+  bool isGoalReached(const Pose2D& robot_pose, const Twist2D& robot_velocity) const override;
 
   const DwaConfig& config() const { return config_; }
   /// @brief The plan, as pruned by the last cycle (the part the robot has not passed yet).
-  const std::vector<Pose2D>& plan() const { return plan_; }
+  const std::vector<Pose2D>& plan() const override { return plan_; }
+  std::string name() const override { return "DWA"; }
+  double footprintRadius() const override { return config_.footprint_radius; }
 
 private:
   /// Within xy_goal_tolerance of the goal (or latched there).

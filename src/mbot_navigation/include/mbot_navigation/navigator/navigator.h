@@ -28,8 +28,8 @@
 #include <vector>
 
 #include "mbot_navigation/costmap/costmap_2d.h"
-#include "mbot_navigation/local_planner/dwa_planner.h"
 #include "mbot_navigation/global_planner/global_planner.h"
+#include "mbot_navigation/local_planner/local_planner.h"
 #include "mbot_navigation/navigator/recovery.h"
 
 namespace mbot_navigation
@@ -86,21 +86,22 @@ class Navigator
 {
 public:
   /**
-   * @param dwa the local planner's settings (a DwaPlanner is built from them)
+   * @param local_planner follows the plan (the nav node gives a DwaPlanner)
    * @param planner the global planner (planner_factory.h)
    * @param recoveries tried in this order
-   * @throws std::invalid_argument for a DWA setting out of range
+   * @throws std::invalid_argument for a setting out of range or a missing planner
    */
-  Navigator(const NavigatorConfig& config, const DwaConfig& dwa, std::unique_ptr<GlobalPlanner> planner,
-            std::vector<std::unique_ptr<RecoveryBehavior>> recoveries);
+  Navigator(const NavigatorConfig& config, std::unique_ptr<LocalPlanner> local_planner,
+            std::unique_ptr<GlobalPlanner> planner, std::vector<std::unique_ptr<RecoveryBehavior>> recoveries);
 
   /// @brief Start navigating to `goal` (costmap frame [m, m, rad]); replaces any current goal.
   void setGoal(const Pose2D& goal, double now);
   /// @brief Drop the current goal (preempted); the next cycle commands zero.
   void cancel();
-  /// @brief New local planner settings (dynamic_reconfigure), in force from the next cycle; the
-  ///        current plan is kept. @throws std::invalid_argument for a setting out of range
-  void setLocalPlannerConfig(const DwaConfig& dwa);
+  /// @brief Replace the local planner (e.g. one with new settings, from dynamic_reconfigure), in
+  ///        force from the next cycle; it is given the current plan.
+  ///        @throws std::invalid_argument for a null planner
+  void setLocalPlanner(std::unique_ptr<LocalPlanner> local_planner);
   NavState state() const { return state_; }
   const Pose2D& goal() const { return goal_; }
 
@@ -122,7 +123,7 @@ public:
   /// @brief The trajectory the local planner chose in the last cycle (empty poses if none).
   const Trajectory& localPlan() const { return local_plan_; }
   const GlobalPlanner& globalPlanner() const { return *planner_; }
-  const DwaPlanner& localPlanner() const { return *dwa_; }
+  const LocalPlanner& localPlanner() const { return *local_planner_; }
   /// @brief The last planner or local planner failure ("" if none since the goal was set), for logs.
   const std::string& lastError() const { return last_error_; }
   /// @brief Names of the recoveries run since the robot last made progress, with their outcome.
@@ -148,7 +149,7 @@ private:
 
   NavigatorConfig config_;
   std::unique_ptr<GlobalPlanner> planner_;
-  std::unique_ptr<DwaPlanner> dwa_;
+  std::unique_ptr<LocalPlanner> local_planner_;
   std::vector<std::unique_ptr<RecoveryBehavior>> recoveries_;
 
   NavState state_ = NavState::IDLE;

@@ -5,7 +5,9 @@
  *        teammates, and publishes the grid as nav_msgs/OccupancyGrid (costmap_2d's 0..100
  *        translation). The layers themselves (layer.h) know nothing of ROS.
  *
- * Layers, bottom to top: static (the map), obstacle (laser), robots (teammates), inflation. The
+ * Layers, bottom to top: static (the map), obstacle (laser), robots (teammates), inflation, or
+ * in the order that `plugins` lists them (each layer works on the grid that the layers below it
+ * made: an inflation layer inflates only what is below it). The
  * nav node owns two: `global_costmap` (the size of the map) and `local_costmap` (a rolling window
  * around the robot). Both must use the same global_frame (the plan is shared between them).
  *
@@ -51,6 +53,15 @@
 
 namespace mbot_navigation
 {
+/// @brief The kinds of layer a CostmapRos can stack (at most one of each).
+enum class LayerKind
+{
+  STATIC,     ///< the map (StaticLayer)
+  OBSTACLE,   ///< the laser (ObstacleLayer)
+  ROBOTS,     ///< the teammates (RobotsLayer)
+  INFLATION,  ///< InflationLayer
+};
+
 /// @brief Everything a CostmapRos is configured with (read once, at start-up).
 struct CostmapRosSettings
 {
@@ -76,6 +87,10 @@ struct CostmapRosSettings
   RobotsLayerConfig robots;
   double robots_padding = 0.1;       ///< [m]
   double robots_scan_margin = 0.15;  ///< [m]
+
+  /// The layers bottom to top: costmap_2d's pre-layer order, or the order of `plugins`. A layer
+  /// listed here is built only when it is on (static_map, scan_topic, robots_layer, inflation).
+  std::vector<LayerKind> layer_order{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::ROBOTS, LayerKind::INFLATION};
 };
 
 /**

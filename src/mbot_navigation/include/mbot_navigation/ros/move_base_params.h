@@ -20,6 +20,8 @@
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include "mbot_navigation/DWAPlannerConfig.h"
+#include "mbot_navigation/InflationConfig.h"
 #include "mbot_navigation/ros/costmap_ros.h"
 #include <mbot_common/ros_edge.h>
 #include "mbot_navigation/navigator/navigator.h"
@@ -84,5 +86,14 @@ struct NavParams
  */
 NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
                         const std::string& description_dir, ParamWarnings& warnings);
+
+// dynamic_reconfigure (cfg/DWAPlanner.cfg, cfg/Inflation.cfg) <-> the settings structs.
+/// @brief The reconfigurable DWA settings of `dwa`, with dwa_local_planner's names.
+DWAPlannerConfig toReconfigure(const DwaConfig& dwa);
+/// @brief `base` with the reconfigurable settings from `config` (the footprint and the control
+///        rate stay `base`'s); not validated (DwaPlanner's constructor does that).
+DwaConfig fromReconfigure(const DWAPlannerConfig& config, const DwaConfig& base);
+InflationConfig toReconfigure(const InflationLayerConfig& inflation);
+InflationLayerConfig fromReconfigure(const InflationConfig& config);
 
 }  // namespace mbot_navigation

@@ -68,60 +68,13 @@
 #include "mbot_navigation/DWAPlannerConfig.h"
 #include "mbot_navigation/InflationConfig.h"
 #include "mbot_navigation/ros/costmap_ros.h"
+#include "mbot_navigation/ros/teammate_tracker.h"
 #include "mbot_navigation/navigator/goal_checks.h"
+#include "mbot_navigation/local_planner/trajectory.h"
 #include "mbot_navigation/navigator/navigator.h"
 
 namespace mbot_navigation
 {
-/**
- * @brief The teammates' states from their topics, for the robots layers: which robots (a fixed
- *        list, or discovered from the /<name>/odom topics), their poses and velocities, and
- *        which of them reported recently enough to be trusted.
- */
-class TeammateTracker
-{
-public:
-  enum class Source
-  {
-    GROUND_TRUTH,  ///< /<name>/base_pose_ground_truth: pose (global frame) and velocity
-    ODOM,          ///< /<name>/odom for the velocity, tf global_frame -> <name>/base_footprint for the pose
-  };
-
-  /**
-   * @param self this robot's name (never a teammate)
-   * @param names a fixed list of teammates; empty: discover them (discover())
-   * @param radius_of footprint radius [m] of a teammate, by name
-   * @param timeout a teammate not heard of for this long [s] is left out
-   */
-  TeammateTracker(tf2_ros::Buffer& tf, const std::string& self, const std::string& global_frame, Source source,
-                  const std::vector<std::string>& names, double timeout,
-                  std::function<double(const std::string&)> radius_of);
-
-  /// @brief Look for /<name>/odom topics (nav_msgs/Odometry) of robots not tracked yet.
-  void discover();
-  /// @brief The teammates that reported within `timeout` of `now`, in the global frame.
-  std::vector<TeammateState> states(const ros::Time& now) const;
-  /// @brief Names tracked so far.
-  std::vector<std::string> names() const;
-
-private:
-  struct Mate
-  {
-    ros::Subscriber sub;
-    nav_msgs::Odometry::ConstPtr last;
-    double radius = 0.2;  ///< [m]
-  };
-  void track(const std::string& name);
-
-  tf2_ros::Buffer& tf_;
-  std::string self_;
-  std::string global_frame_;
-  Source source_;
-  double timeout_;
-  std::function<double(const std::string&)> radius_of_;
-  std::map<std::string, Mate> mates_;
-};
-
 /// @brief The nav node (see the file comment).
 class NavNode
 {
@@ -150,7 +103,6 @@ private:
   std::string goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, Pose2D& out) const;
   /// Why the goal cannot be taken ("" when it can); `out` is the goal in the global frame.
   std::string checkGoal(const geometry_msgs::PoseStamped& goal, Pose2D& out);
-  double teammateRadius(const std::string& name);
   void publishPath(const ros::Publisher& pub, const std::vector<Pose2D>& path, const ros::Time& stamp) const;
   void publishZero();
   /// Start the dynamic_reconfigure servers with the settings in force.
@@ -161,13 +113,10 @@ private:
   ros::NodeHandle nh_, private_nh_;
   std::string robot_;
   std::string global_frame_, robot_base_frame_;
-  std::string description_dir_;
-  double own_radius_ = 0.15;  ///< [m]
-  std::string own_model_;
-  std::map<std::string, double> model_radius_;  ///< cache: model name -> footprint radius [m]
-  double controller_patience_ = 15.0;           ///< also how long a missing robot pose is tolerated [s]
-  double transform_tolerance_ = 0.5;            ///< an older robot pose counts as missing [s] (global_costmap's)
-  double control_period_ = 0.05;                ///< 1 / controller_frequency [s]
+  double controller_patience_ = 15.0;  ///< also how long a missing robot pose is tolerated [s]
+  double transform_tolerance_ = 0.5;   ///< an older robot pose counts as missing [s] (global_costmap's)
+  double control_period_ = 0.05;       ///< 1 / controller_frequency [s]
+  DwaConfig dwa_config_;               ///< the settings of the local planner in force (a DwaPlanner)
 
   std::unique_ptr<tf2_ros::Buffer> tf_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
