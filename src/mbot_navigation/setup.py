@@ -1,4 +1,4 @@
-# Installs the Python package src/mbot_navigation (catkin_python_setup in cmake/nav_node.cmake);
+# Installs the Python package src/mbot_navigation (catkin_python_setup in CMakeLists.txt);
 # not for pip. Other modules of this package go into the same src/mbot_navigation folder.
 from setuptools import setup
 

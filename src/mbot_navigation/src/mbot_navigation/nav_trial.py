@@ -6,7 +6,7 @@ other, in a world of its own roslaunch; count the goals reached and the contacts
 
 prints ``{"runs", "succeeded", "contacts", "sim_seconds", "wall_seconds", "robots", "mean_goal_s"}``.
 
-- The world defaults to test/worlds/nav_office.world.yaml (the office with one robot, robot_0,
+- The world defaults to test/fixtures/worlds/nav_office.world.yaml (the office with one robot, robot_0,
   and the crate). The program starts ``fleet_navigation.launch`` on a free private port (its own
   master) and stops it at the end.
 - ``--robots N`` drives the world's first N robots at once, each its own sequence of goals (the
@@ -50,9 +50,9 @@ ROBOT_RADIUS = 0.15  # [m] mbot's footprint; the clearance default keeps goals w
 
 
 def default_world():
-    """test/worlds/nav_office.world.yaml of this package (source tree)."""
+    """test/fixtures/worlds/nav_office.world.yaml of this package (source tree)."""
     here = os.path.dirname(os.path.abspath(__file__))  # src/mbot_navigation
-    return os.path.normpath(os.path.join(here, "..", "..", "test", "worlds", "nav_office.world.yaml"))
+    return os.path.normpath(os.path.join(here, "..", "..", "test", "fixtures", "worlds", "nav_office.world.yaml"))
 
 
 def static_obstacles(world_path):

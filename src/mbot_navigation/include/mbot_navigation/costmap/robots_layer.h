@@ -1,0 +1,71 @@
+/**
+ * @file robots_layer.h
+ * @brief "Other robots" layer: teammates as moving obstacles, not as static walls.
+ *
+ * A teammate seen by the laser would be marked by the obstacle layer and stay there until a beam
+ * clears it. This layer instead draws each teammate from its reported state at every update:
+ * its footprint as LETHAL (the inflation layer, added after this one, inflates it like any
+ * obstacle) and the area it will sweep in the next `prediction_time` seconds, grown by this robot's
+ * own radius, as a high but passable cost, so that planners prefer to pass behind it. Nothing is
+ * remembered: every update erases the previous drawing.
+ */
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mbot_navigation/costmap/layer.h"
+
+namespace mbot_navigation
+{
+/// @brief RobotsLayer settings.
+struct RobotsLayerConfig
+{
+  double prediction_time = 1.0;   ///< how far ahead a teammate's motion is marked [s]
+  double prediction_step = 0.1;   ///< time step of that prediction [s]
+  uint8_t prediction_cost = 200;  ///< cost of the predicted sweep [0..252]; < INSCRIBED: passable
+};
+
+/// @brief What the fleet reports about one teammate.
+struct TeammateState
+{
+  std::string name;     ///< for messages, e.g. "robot_1"
+  Pose2D pose;          ///< in the costmap frame [m, m, rad]
+  double radius = 0.2;  ///< footprint radius [m]
+  double vx = 0.0;      ///< forward velocity, body frame [m/s]
+  double vy = 0.0;      ///< sideways velocity, body frame [m/s] (omni robots; 0 for diff drive)
+  double wz = 0.0;      ///< yaw rate [rad/s]
+};
+
+/// @brief Draws teammates (footprint LETHAL, predicted sweep `prediction_cost`) at every update.
+class RobotsLayer : public Layer
+{
+public:
+  explicit RobotsLayer(const RobotsLayerConfig& config = RobotsLayerConfig());
+
+  std::string name() const override { return "robots_layer"; }
+
+  /// @brief Replace the teammates drawn from the next update on (not this robot itself).
+  void setTeammates(const std::vector<TeammateState>& teammates) { teammates_ = teammates; }
+  const std::vector<TeammateState>& teammates() const { return teammates_; }
+
+  void onFootprintChanged(double robot_radius) override { robot_radius_ = robot_radius; }
+  void updateBounds(const Pose2D& robot, Bounds& bounds) override;
+  void updateCosts(Costmap2D& master, const CellWindow& window) override;
+  void reset() override { teammates_.clear(); }
+
+  /// @brief The poses a teammate is predicted at, from now to prediction_time (constant twist).
+  std::vector<Pose2D> predict(const TeammateState& mate) const;
+
+private:
+  /// @brief Raise the cells whose centre is within `radius` [m] of (x, y) [m] to `c` (max).
+  static void drawDisc(Costmap2D& master, const CellWindow& window, double x, double y, double radius, uint8_t c);
+
+  RobotsLayerConfig config_;
+  std::vector<TeammateState> teammates_;
+  double robot_radius_ = 0.0;  ///< this robot's radius [m]
+  Bounds last_bounds_;         ///< what the previous update drew, to erase it
+};
+
+}  // namespace mbot_navigation

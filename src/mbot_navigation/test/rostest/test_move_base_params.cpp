@@ -1,0 +1,268 @@
+// The nav node's parameter reader (move_base_params.h) on a parameter server (rostest
+// move_base_params.test): a tutorial-style move_base set loads with warnings only, each naming
+// its key; a key nobody knows is an error naming it; the plugins form picks the layers.
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <ros/package.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+
+#include "mbot_navigation/ros/move_base_params.h"
+
+using namespace mbot_navigation;
+
+namespace
+{
+std::string descriptionDir() { return ros::package::getPath("mbot_description"); }
+
+NavParams read(const std::string& ns, ParamWarnings& warnings)
+{
+  return readNavParams(ros::NodeHandle("/" + ns), ros::NodeHandle("/" + ns + "/move_base"), descriptionDir(), warnings);
+}
+
+/// The error text of reading `ns` ("" when it loads).
+std::string readError(const std::string& ns)
+{
+  ParamWarnings warnings;
+  try
+  {
+    read(ns, warnings);
+  }
+  catch (const std::runtime_error& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+
+bool warned(const ParamWarnings& warnings, const std::string& key)
+{
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(key + ":") != std::string::npos; });
+}
+
+/// Copy the tutorial set of /robot_0/move_base into /<ns>/move_base.
+void copyTutorialSet(const std::string& ns)
+{
+  XmlRpc::XmlRpcValue all;
+  ASSERT_TRUE(ros::param::get("/robot_0/move_base", all));
+  ros::param::set("/" + ns + "/move_base", all);
+}
+}  // namespace
+
+TEST(MoveBaseParams, TutorialSetLoadsWithWarningsOnly)
+{
+  ParamWarnings warnings;
+  NavParams p;
+  ASSERT_NO_THROW(p = read("robot_0", warnings));
+  // move_base's meanings and units
+  EXPECT_EQ(p.global_planner, "astar");  // navfn/NavfnROS
+  EXPECT_DOUBLE_EQ(p.controller_frequency, 10.0);
+  EXPECT_DOUBLE_EQ(p.nav.planner_frequency, 1.0);
+  EXPECT_DOUBLE_EQ(p.nav.oscillation_distance, 0.2);
+  EXPECT_EQ(p.global_costmap.global_frame, "map");  // "/map", tf1 style
+  EXPECT_EQ(p.local_costmap.global_frame, "map");   // odom: runs in the global costmap's frame
+  EXPECT_TRUE(p.global_costmap.static_map);
+  EXPECT_FALSE(p.local_costmap.static_map);
+  EXPECT_TRUE(p.local_costmap.costmap.rolling_window);
+  EXPECT_NEAR(p.global_costmap.costmap.robot_radius, std::hypot(0.12, 0.12) + 0.01, 1e-9);  // footprint + padding
+  EXPECT_EQ(p.global_costmap.scan_topic, "scan");                                           // from observation_sources
+  EXPECT_DOUBLE_EQ(p.global_costmap.obstacle_layer.obstacle_range, 2.5);
+  EXPECT_DOUBLE_EQ(p.global_costmap.inflation_layer.inflation_radius, 0.55);
+  EXPECT_DOUBLE_EQ(p.local_costmap.inflation_layer.cost_scaling_factor, 5.0);
+  EXPECT_DOUBLE_EQ(p.dwa.max_vel_x, 0.45);
+  EXPECT_DOUBLE_EQ(p.dwa.max_vel_theta, 1.5);
+  EXPECT_DOUBLE_EQ(p.dwa.xy_goal_tolerance, 0.15);
+  EXPECT_EQ(p.dwa.vx_samples, 6);
+  EXPECT_DOUBLE_EQ(p.dwa.controller_frequency, 10.0);  // move_base's, not DWAPlannerROS/controller_frequency
+
+  for (const std::string& key :
+       {"/robot_0/move_base/conservative_reset_dist", "/robot_0/move_base/shutdown_costmaps",
+        "/robot_0/move_base/NavfnROS/default_tolerance", "/robot_0/move_base/NavfnROS/visualize_potential",
+        "/robot_0/move_base/DWAPlannerROS/publish_traj_pc", "/robot_0/move_base/DWAPlannerROS/stop_time_buffer",
+        "/robot_0/move_base/DWAPlannerROS/controller_frequency",
+        "/robot_0/move_base/global_costmap/always_send_full_costmap",
+        "/robot_0/move_base/global_costmap/laser_scan_sensor/sensor_frame",
+        "/robot_0/move_base/local_costmap/laser_scan_sensor/expected_update_rate",
+        "/robot_0/move_base/local_costmap/global_frame", "/robot_0/move_base/global_costmap/footprint"})
+    EXPECT_TRUE(warned(warnings, key)) << key;
+  // Exactly one warning per ignored key (nothing is reported twice).
+  for (const std::string& w : warnings) EXPECT_EQ(std::count(warnings.begin(), warnings.end(), w), 1) << w;
+  // Implemented keys give no warning.
+  for (const std::string& key :
+       {"/robot_0/move_base/DWAPlannerROS/max_vel_x", "/robot_0/move_base/controller_frequency",
+        "/robot_0/move_base/global_costmap/inflation_radius"})
+    EXPECT_FALSE(warned(warnings, key)) << key;
+}
+
+TEST(MoveBaseParams, UnknownKeyIsAnErrorNamingIt)
+{
+  copyTutorialSet("typo");
+  ros::param::set("/typo/move_base/DWAPlannerROS/max_vel_xx", 0.3);
+  std::string error = readError("typo");
+  EXPECT_NE(error.find("max_vel_xx"), std::string::npos) << error;
+  EXPECT_NE(error.find("/typo/move_base/DWAPlannerROS"), std::string::npos) << error;
+
+  copyTutorialSet("typo2");
+  ros::param::set("/typo2/move_base/local_costmap/inflation_raduis", 0.3);
+  error = readError("typo2");
+  EXPECT_NE(error.find("inflation_raduis"), std::string::npos) << error;
+
+  copyTutorialSet("typo3");
+  ros::param::set("/typo3/move_base/global_costmap/laser_scan_sensor/markign", true);
+  error = readError("typo3");
+  EXPECT_NE(error.find("markign"), std::string::npos) << error;
+}
+
+TEST(MoveBaseParams, PlannerNames)
+{
+  copyTutorialSet("gp");
+  ros::param::set("/gp/move_base/base_global_planner", std::string("global_planner/GlobalPlanner"));
+  ros::param::set("/gp/move_base/GlobalPlanner/use_dijkstra", false);
+  ParamWarnings warnings;
+  EXPECT_EQ(read("gp", warnings).global_planner, "astar");
+  EXPECT_TRUE(warned(warnings, "/gp/move_base/GlobalPlanner/use_dijkstra"));
+
+  copyTutorialSet("carrot");
+  ros::param::set("/carrot/move_base/base_global_planner", std::string("carrot_planner/CarrotPlanner"));
+  EXPECT_NE(readError("carrot").find("carrot_planner/CarrotPlanner"), std::string::npos);
+
+  copyTutorialSet("tpr");
+  ros::param::set("/tpr/move_base/base_local_planner", std::string("base_local_planner/TrajectoryPlannerROS"));
+  const std::string error = readError("tpr");
+  EXPECT_NE(error.find("/tpr/move_base/base_local_planner"), std::string::npos) << error;
+  EXPECT_NE(error.find("not supported"), std::string::npos) << error;
+}
+
+TEST(MoveBaseParams, PluginsPickTheLayers)
+{
+  ParamWarnings warnings;
+  CostmapRosSettings d;
+  const CostmapRosSettings s = readCostmapSettings(ros::NodeHandle("/plugins/move_base/global_costmap"), d, &warnings);
+  EXPECT_TRUE(s.static_map);
+  EXPECT_EQ(s.scan_topic, "scan");
+  EXPECT_DOUBLE_EQ(s.obstacle_layer.obstacle_range, 2.0);  // the source's own
+  EXPECT_TRUE(s.robots_layer);
+  EXPECT_DOUBLE_EQ(s.robots.prediction_time, 1.5);
+  EXPECT_TRUE(s.inflation);
+  EXPECT_EQ(s.inflation_layer_name, "inflater");
+  EXPECT_DOUBLE_EQ(s.inflation_layer.inflation_radius, 0.4);  // the layer's, not the flat 0.9
+  EXPECT_DOUBLE_EQ(s.inflation_layer.cost_scaling_factor, 8.0);
+  EXPECT_DOUBLE_EQ(s.costmap.robot_radius, 0.17);
+  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/inflation_radius"));
+  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/static_layer/subscribe_to_updates"));
+  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/obstacle_layer/z_voxels"));
+
+  // A layer left out is not there; `enabled: false` turns one off.
+  ros::param::set("/plugins2/global_costmap/plugins", [] {
+    XmlRpc::XmlRpcValue list;
+    list[0]["name"] = "static_layer";
+    list[0]["type"] = "costmap_2d::StaticLayer";
+    list[1]["name"] = "inflation_layer";
+    list[1]["type"] = "costmap_2d::InflationLayer";
+    return list;
+  }());
+  ros::param::set("/plugins2/global_costmap/inflation_layer/enabled", false);
+  warnings.clear();
+  const CostmapRosSettings s2 = readCostmapSettings(ros::NodeHandle("/plugins2/global_costmap"), d, &warnings);
+  EXPECT_TRUE(s2.static_map);
+  EXPECT_TRUE(s2.scan_topic.empty());
+  EXPECT_FALSE(s2.robots_layer);
+  EXPECT_FALSE(s2.inflation);
+
+  // An unknown layer type is an error naming it.
+  ros::param::set("/plugins3/global_costmap/plugins", [] {
+    XmlRpc::XmlRpcValue list;
+    list[0]["name"] = "social";
+    list[0]["type"] = "social_navigation_layers::ProxemicLayer";
+    return list;
+  }());
+  try
+  {
+    readCostmapSettings(ros::NodeHandle("/plugins3/global_costmap"), d, &warnings);
+    FAIL() << "an unknown layer type was accepted";
+  }
+  catch (const std::runtime_error& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("social_navigation_layers::ProxemicLayer"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'social'"), std::string::npos) << e.what();
+  }
+}
+
+namespace
+{
+/// A plugins list of a robots layer and an inflation layer, in this order or the other.
+XmlRpc::XmlRpcValue robotsAndInflation(bool inflation_last)
+{
+  XmlRpc::XmlRpcValue list;
+  const int robots = inflation_last ? 0 : 1;
+  list[robots]["name"] = "robots";
+  list[robots]["type"] = "mbot_navigation::RobotsLayer";
+  list[1 - robots]["name"] = "inflation_layer";
+  list[1 - robots]["type"] = "costmap_2d::InflationLayer";
+  return list;
+}
+
+/// The cost at (x, y) [m] after one update with a teammate standing at (1, 0).
+uint8_t costNearATeammate(const CostmapRosSettings& settings, double x, double y)
+{
+  ros::NodeHandle nh("/order"), private_nh("/order/move_base");
+  tf2_ros::Buffer tf;
+  CostmapRos costmap("global_costmap", settings, nh, private_nh, tf);
+  TeammateState mate;
+  mate.name = "robot_1";
+  mate.pose = Pose2D{1.0, 0.0, 0.0};
+  mate.radius = 0.2;
+  costmap.setTeammates({mate});
+  costmap.update(Pose2D{0.0, 0.0, 0.0}, ros::Time(1.0));
+  unsigned mx, my;
+  EXPECT_TRUE(costmap.costmap().worldToMap(x, y, mx, my));
+  return costmap.costmap().cost(mx, my);
+}
+}  // namespace
+
+TEST(MoveBaseParams, LayersAreStackedInTheListedOrder)
+{
+  CostmapRosSettings d;
+  EXPECT_EQ(d.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::ROBOTS,
+                                                   LayerKind::INFLATION}));  // costmap_2d's pre-layer order
+  d.costmap.rolling_window = true;                                           // no map needed
+  d.costmap.width = d.costmap.height = 4.0;
+  d.costmap.robot_radius = 0.15;
+  ParamWarnings warnings;
+  ros::param::set("/order_last/global_costmap/plugins", robotsAndInflation(true));
+  ros::param::set("/order_first/global_costmap/plugins", robotsAndInflation(false));
+  const CostmapRosSettings last = readCostmapSettings(ros::NodeHandle("/order_last/global_costmap"), d, &warnings);
+  const CostmapRosSettings first = readCostmapSettings(ros::NodeHandle("/order_first/global_costmap"), d, &warnings);
+  EXPECT_EQ(last.layer_order, (std::vector<LayerKind>{LayerKind::ROBOTS, LayerKind::INFLATION}));
+  EXPECT_EQ(first.layer_order, (std::vector<LayerKind>{LayerKind::INFLATION, LayerKind::ROBOTS}));
+  ASSERT_TRUE(last.inflation && last.robots_layer && first.inflation && first.robots_layer);
+
+  // The teammate (radius 0.2 m, drawn 0.1 m bigger) is lethal either way; 0.5 m from its centre
+  // there is inflation only when the inflation layer is above the robots layer.
+  EXPECT_EQ(costNearATeammate(last, 1.0, 0.0), cost::LETHAL);
+  EXPECT_EQ(costNearATeammate(first, 1.0, 0.0), cost::LETHAL);
+  EXPECT_GT(costNearATeammate(last, 1.5, 0.0), cost::FREE);
+  EXPECT_EQ(costNearATeammate(first, 1.5, 0.0), cost::FREE);
+}
+
+TEST(MoveBaseParams, FootprintRadius)
+{
+  XmlRpc::XmlRpcValue text("[[-0.1, -0.1], [-0.1, 0.1], [0.3, 0.0]]");
+  EXPECT_DOUBLE_EQ(footprintRadius(text, "f"), 0.3);
+  XmlRpc::XmlRpcValue two("[[0.1, 0.1], [0.2, 0.0]]");
+  EXPECT_THROW(footprintRadius(two, "f"), std::runtime_error);
+  XmlRpc::XmlRpcValue bad("[[0.1, x]]");
+  EXPECT_THROW(footprintRadius(bad, "f"), std::runtime_error);
+}
+
+int main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_move_base_params");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
