@@ -191,7 +191,8 @@ class NavServices(unittest.TestCase):
             scan_pub.publish(phantom_scan(tf_buffer, *phantom))
             return costmap.value(*phantom) == 100
 
-        wait_until(marked, 60.0, "the extra beam's mark at (%.3f, %.3f) in the global costmap" % phantom)
+        wait_until(marked, 60.0, "the extra beam's mark at (%.3f, %.3f) in the global costmap" % phantom,
+                   period=0.1)  # a scan per poll: at the laser's rate
         wait_until(costmap.after(2), 10.0, "two more global costmaps")
         self.assertEqual(costmap.value(*phantom), 100, "the mark should stay (no beam of the simulator gets there)")
 
