@@ -10,6 +10,7 @@ then converges again.
 """
 import math
 import re
+import time
 import unittest
 
 import numpy as np
@@ -83,11 +84,12 @@ def set_yaw(q, yaw):
     q.x, q.y, q.z, q.w = 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
-def connected_to_every_publisher(sub):
-    """True once `sub` has a connection to every publisher of its topic that the master knows
-    (rospy counts its own node's publisher too)."""
-    publishers = dict(rosgraph.Master(rospy.get_name()).getSystemState()[0]).get(sub.resolved_name, [])
-    return sub.get_num_connections() >= len(publishers)
+def connected_to_all(topic):
+    """True once a rospy Subscriber (Publisher) has a connection to every publisher (subscriber)
+    of its topic that the master knows (rospy counts its own node's too)."""
+    other_side = 0 if isinstance(topic, rospy.Subscriber) else 1
+    nodes = dict(rosgraph.Master(rospy.get_name()).getSystemState()[other_side]).get(topic.resolved_name, [])
+    return topic.get_num_connections() >= len(nodes)
 
 
 class PfLocalizationTest(unittest.TestCase):
@@ -186,16 +188,18 @@ class PfLocalizationTest(unittest.TestCase):
         scan.ranges = ray_cast(self.occupied, laser[0], laser[1], laser[2], self.rng).tolist()
         self.scan_pub.publish(scan)
         self.truth_at[self.now] = self.truth
-        # Until then the clock ticks on in 1 ms steps (at most half a step), as a simulator's
-        # would: a node that waits for a transform in sim time sleeps until the clock moves.
+        # Until then the clock ticks on by 1 ms every 0.1 s wall (at most half a step), as a
+        # simulator's would: a node that waits for a transform in sim time sleeps until the
+        # clock moves.
         odom_frame = self.robot + "/odom"
-        clock = [self.now]
+        clock = [self.now, time.time()]
 
         def taken():
             if self.buffer.can_transform("map", odom_frame, self.now + self.tolerance):
                 return True
-            if clock[0] < self.now + rospy.Duration(0.5 * STEP):
+            if clock[0] < self.now + rospy.Duration(0.5 * STEP) and time.time() > clock[1] + 0.1:
                 clock[0] += rospy.Duration(0.001)
+                clock[1] = time.time()
                 self.clock_pub.publish(Clock(clock=clock[0]))
             return False
 
@@ -231,7 +235,8 @@ class PfLocalizationTest(unittest.TestCase):
             wait_for(lambda: sub.get_num_connections() > 0, 30, "a publisher on " + sub.name)
         for pub in (self.scan_pub, self.tf_pub, self.clock_pub, self.map_pub):
             wait_for(lambda: pub.get_num_connections() > 0, 30, "a subscriber on " + pub.name)
-        wait_for(lambda: connected_to_every_publisher(self.log_sub), 30, "every publisher on /rosout")
+        wait_for(lambda: connected_to_all(self.log_sub), 30, "every publisher on /rosout")
+        wait_for(lambda: connected_to_all(self.static_tf.pub_tf), 30, "every subscriber on /tf_static")
         self.publish_world()
         wait_for(lambda: self.said(r"pf_localization: map \d+ x \d+ at") > 0, 30, "pf_localization to take the map")
 
