@@ -9,16 +9,18 @@ post-dated by transform_tolerance, and a /<robot>/initialpose re-initializes the
 then converges again.
 """
 import math
+import re
 import time
 import unittest
 
 import numpy as np
+import rosgraph
 import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped, TransformStamped
 from nav_msgs.msg import OccupancyGrid
-from rosgraph_msgs.msg import Clock
+from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
@@ -82,6 +84,14 @@ def set_yaw(q, yaw):
     q.x, q.y, q.z, q.w = 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
+def connected_to_all(topic):
+    """True once a rospy Subscriber (Publisher) has a connection to every publisher (subscriber)
+    of its topic that the master knows (rospy counts its own node's too)."""
+    other_side = 0 if isinstance(topic, rospy.Subscriber) else 1
+    nodes = dict(rosgraph.Master(rospy.get_name()).getSystemState()[other_side]).get(topic.resolved_name, [])
+    return topic.get_num_connections() >= len(nodes)
+
+
 class PfLocalizationTest(unittest.TestCase):
     def setUp(self):
         self.robot = rospy.get_param("~robot")
@@ -106,9 +116,20 @@ class PfLocalizationTest(unittest.TestCase):
         self.clouds = []
         self.cloud_sub = rospy.Subscriber("/%s/particlecloud" % self.robot, PoseArray,
                                           self.clouds.append)
+        self.log = []  # what pf_localization said (/rosout): when it took the map or an initial pose
+        self.log_sub = rospy.Subscriber("/rosout", Log, self.on_log)
+        self.tolerance = rospy.Duration(rospy.get_param("/%s/pf_localization/transform_tolerance" % self.robot))
         self.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(600))
         self.listener = tf2_ros.TransformListener(self.buffer)
         self.static_tf = tf2_ros.StaticTransformBroadcaster()
+
+    def on_log(self, msg):
+        if msg.name.endswith("pf_localization"):
+            self.log.append(msg.msg)
+
+    def said(self, pattern):
+        """How many of pf_localization's log lines start with the regular expression `pattern`."""
+        return sum(1 for line in list(self.log) if re.match(pattern, line))
 
     # ------------------------------------------------------------ the simulated world
     def publish_world(self):
@@ -138,7 +159,9 @@ class PfLocalizationTest(unittest.TestCase):
         error = math.remainder(math.atan2(dy, dx) - self.truth[2], 2.0 * math.pi)
         return (0.05 if abs(error) < 0.3 else 0.005, 0.0, max(-0.15, min(0.15, error)))
 
-    def step(self, sleep=0.03):
+    def step(self):
+        """One scan of sim time; returns once the node took the scan (it re-sends map -> odom,
+        post-dated by transform_tolerance, with every scan)."""
         self.now += rospy.Duration(STEP)
         motion = self.drive()
         self.truth = compose(self.truth, motion)
@@ -165,7 +188,22 @@ class PfLocalizationTest(unittest.TestCase):
         scan.ranges = ray_cast(self.occupied, laser[0], laser[1], laser[2], self.rng).tolist()
         self.scan_pub.publish(scan)
         self.truth_at[self.now] = self.truth
-        time.sleep(sleep)
+        # Until then the clock ticks on by 1 ms every 0.1 s wall (at most half a step), as a
+        # simulator's would: a node that waits for a transform in sim time sleeps until the
+        # clock moves.
+        odom_frame = self.robot + "/odom"
+        clock = [self.now, time.time()]
+
+        def taken():
+            if self.buffer.can_transform("map", odom_frame, self.now + self.tolerance):
+                return True
+            if clock[0] < self.now + rospy.Duration(0.5 * STEP) and time.time() > clock[1] + 0.1:
+                clock[0] += rospy.Duration(0.001)
+                clock[1] = time.time()
+                self.clock_pub.publish(Clock(clock=clock[0]))
+            return False
+
+        wait_for(taken, 10, "tf map -> odom for the scan at %.1f s" % self.now.to_sec())
 
     # ------------------------------------------------------------ checks
     def pose_error(self, msg):
@@ -178,7 +216,6 @@ class PfLocalizationTest(unittest.TestCase):
         count = len(self.poses)
         for _ in range(steps):
             self.step()
-        time.sleep(0.5)  # let the last update arrive
         updates = self.poses[count:]
         self.assertGreater(len(updates), 15, "%s: too few filter updates" % label)
         last = updates[-1]
@@ -198,19 +235,17 @@ class PfLocalizationTest(unittest.TestCase):
             wait_for(lambda: sub.get_num_connections() > 0, 30, "a publisher on " + sub.name)
         for pub in (self.scan_pub, self.tf_pub, self.clock_pub, self.map_pub):
             wait_for(lambda: pub.get_num_connections() > 0, 30, "a subscriber on " + pub.name)
+        wait_for(lambda: connected_to_all(self.log_sub), 30, "every publisher on /rosout")
+        wait_for(lambda: connected_to_all(self.static_tf.pub_tf), 30, "every subscriber on /tf_static")
         self.publish_world()
-        time.sleep(0.5)  # the map and the laser mount reach the node
+        wait_for(lambda: self.said(r"pf_localization: map \d+ x \d+ at") > 0, 30, "pf_localization to take the map")
 
         # 1. from the launch file's initial pose (0.3 m, 0.2 rad off)
         self.drive_and_check(150, "initial pose from args")
 
         # map -> odom is re-sent with every scan, post-dated by transform_tolerance (0.1 s)
-        tolerance = rospy.Duration(rospy.get_param("/%s/pf_localization/transform_tolerance" % self.robot))
-        odom_frame = self.robot + "/odom"
-        wait_for(lambda: self.buffer.can_transform("map", odom_frame, self.now + tolerance), 10,
-                 "tf map -> odom at the last scan + transform_tolerance")
-        latest = self.buffer.lookup_transform("map", odom_frame, rospy.Time(0))
-        self.assertEqual(latest.header.stamp, self.now + tolerance)
+        latest = self.buffer.lookup_transform("map", self.robot + "/odom", rospy.Time(0))
+        self.assertEqual(latest.header.stamp, self.now + self.tolerance)
         # and map -> odom -> base lands on the truth
         map_odom = (latest.transform.translation.x, latest.transform.translation.y,
                     yaw_of(latest.transform.rotation))
@@ -229,8 +264,10 @@ class PfLocalizationTest(unittest.TestCase):
         guess.pose.covariance[35] = 0.0685
         wait_for(lambda: self.initial_pub.get_num_connections() > 0, 30, "initialpose subscriber")
         count = len(self.poses)
+        said = self.said(r"pf_localization: initial pose \(")
         self.initial_pub.publish(guess)
-        time.sleep(0.5)
+        wait_for(lambda: self.said(r"pf_localization: initial pose \(") > said, 10,
+                 "pf_localization to take initialpose")
         self.step()  # the first scan after a new initial pose is an update without motion
         wait_for(lambda: len(self.poses) > count, 10, "the update after initialpose")
         restarted = self.poses[count]

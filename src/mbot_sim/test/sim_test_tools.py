@@ -9,6 +9,7 @@ import threading
 import time
 
 import rospy
+from mbot_common.waits import wait_for_sim as wait_until  # noqa: F401 (the tests import it from here)
 
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
 
@@ -45,15 +46,13 @@ class Recorder(object):
 
     def first_stamped_after(self, t, sim_timeout=5.0):
         """The first message whose header stamp is later than sim time t (waits for it)."""
-        deadline = rospy.get_time() + sim_timeout
-        wall_deadline = time.time() + 60.0
-        while not rospy.is_shutdown() and rospy.get_time() < deadline and time.time() < wall_deadline:
+        def first():
             with self._lock:
-                for (_, m) in self.messages:
-                    if m.header.stamp.to_sec() > t:
-                        return m
-            rospy.sleep(0.01)
-        raise AssertionError("no message on %s stamped after t = %.2f" % (self.sub.name, t))
+                return next((m for (_, m) in self.messages if m.header.stamp.to_sec() > t), None)
+
+        wait_until(lambda: first() is not None, sim_timeout,
+                   "a message on %s stamped after t = %.2f" % (self.sub.name, t))
+        return first()
 
     def wait_for_first(self, wall_timeout=30.0):
         end = time.time() + wall_timeout
@@ -62,18 +61,6 @@ class Recorder(object):
                 return self.latest()
             time.sleep(0.05)
         raise AssertionError("no message on %s within %.0f s (wall)" % (self.sub.name, wall_timeout))
-
-
-def wait_until(condition, sim_timeout, what):
-    """Wait (sim time) until condition() is true; fail naming `what` after sim_timeout."""
-    deadline = rospy.get_time() + sim_timeout
-    wall_deadline = time.time() + 60.0
-    while not rospy.is_shutdown() and rospy.get_time() < deadline and time.time() < wall_deadline:
-        if condition():
-            return
-        rospy.sleep(0.01)
-    if not condition():
-        raise AssertionError("timed out waiting for " + what)
 
 
 def wait_for_connection(publisher, wall_timeout=10.0):

@@ -20,6 +20,7 @@ from std_srvs.srv import Empty
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 from sim_test_tools import (Recorder, drive_until, publish_for, wait_for_connection,  # noqa: E402
                             wait_until)
+from mbot_common.waits import wait_for_wall  # noqa: E402
 
 
 def pose2d(x, y, theta):
@@ -116,7 +117,7 @@ class SimServices(unittest.TestCase):
         res = self.remove("robot_3")
         self.assertTrue(res.success, res.message)
         t_removed = rospy.get_time()
-        rospy.sleep(1.0)
+        self.truth["robot_0"].first_stamped_after(t_removed + 1.0)  # the simulator went on for 1 s
         # (0.2 s: the test's clock may lag the simulator's a little)
         self.assertEqual(len(odom3.stamped_after(t_removed + 0.2)), 0, "a removed robot must not publish")
         self.assertNotIn("robot_3", [r["name"] for r in rospy.get_param("/stage/robots")])
@@ -141,8 +142,10 @@ class SimServices(unittest.TestCase):
         res = self.teleport("robot_9", pose2d(5.0, 6.0, 0.0))
         self.assertFalse(res.success)
         self.assertIn("unknown robot", res.message)
-        rospy.sleep(0.5)
-        self.assertAlmostEqual(self.pose_of("robot_1")[0], 5.0, delta=1e-6)  # unchanged
+        # unchanged in a pose measured after the refused requests (the test's clock may lag)
+        after = self.truth["robot_1"].first_stamped_after(rospy.get_time() + 0.2).pose.pose.position
+        self.assertAlmostEqual(after.x, 5.0, delta=1e-6)
+        self.assertAlmostEqual(after.y, 5.0, delta=1e-6)
 
         # cmd_pose is a geometry_msgs/Pose as in stage_ros: z, roll and pitch are ignored, the yaw
         # comes from the quaternion (here one with roll 0.3 and a non-unit length).
@@ -162,8 +165,7 @@ class SimServices(unittest.TestCase):
         res = self.set_fault(fault("robot_0", laser_dropout=0.5))
         self.assertTrue(res.success, res.message)
         t0 = rospy.get_time() + 0.2  # measured after the fault was set (the test's clock may lag)
-        self.scan0.first_stamped_after(t0 + 2.0)
-        rospy.sleep(0.5)
+        self.scan0.first_stamped_after(t0 + 2.0)  # so every earlier scan has arrived (one topic: in order)
         scans = [m for m in self.scan0.stamped_after(t0) if m.header.stamp.to_sec() <= t0 + 2.0]
         self.assertGreaterEqual(len(scans), 19)
         # a dropped beam reads NaN (REP-117 invalid), not +Inf
@@ -203,15 +205,25 @@ class SimServices(unittest.TestCase):
         self.assertLess(self.pose_of("robot_2")[0], x0 - 0.1)  # backed up once repaired
 
     def test_fault_silenced_and_latency(self):
+        # Silenced for at least 1 s of sim time (1.5 s by this process's clock, which may lag the
+        # simulator's); measured from the stamps alone: a gap in odometry and scans, none in the
+        # ground truth.
+        silenced_at = rospy.get_time()
         self.assertTrue(self.set_fault(fault("robot_0", silenced=True)).success)
-        t0 = rospy.get_time() + 0.2  # (the test's clock may lag the simulator's)
-        t1 = t0 + 1.0
-        self.truth["robot_0"].first_stamped_after(t1)  # ground truth measured after t1 has arrived
-        rospy.sleep(0.5)  # and what else was measured before t1, too
-        window = lambda rec: [m for m in rec.stamped_after(t0) if m.header.stamp.to_sec() <= t1]  # noqa: E731
-        self.assertEqual(len(window(self.odom["robot_0"])), 0)
-        self.assertEqual(len(window(self.scan0)), 0)
-        self.assertAlmostEqual(len(window(self.truth["robot_0"])), 50, delta=1)  # ground truth goes on
+        self.truth["robot_0"].first_stamped_after(silenced_at + 1.5)
+        resumed_at = rospy.get_time()
+        self.assertTrue(self.set_fault(fault("robot_0")).success)  # speaks again
+        # The first odometry and scan after that follow (on each topic, in order) all before.
+        for rec in (self.odom["robot_0"], self.scan0, self.truth["robot_0"]):
+            rec.first_stamped_after(resumed_at)
+
+        def largest_gap(rec):
+            stamps = sorted(m.header.stamp.to_sec() for m in rec.stamped_after(silenced_at - 1.0))
+            return max(b - a for a, b in zip(stamps, stamps[1:]))
+
+        self.assertGreater(largest_gap(self.odom["robot_0"]), 1.0)
+        self.assertGreater(largest_gap(self.scan0), 1.0)
+        self.assertAlmostEqual(largest_gap(self.truth["robot_0"]), 0.02, delta=1e-6)  # ground truth goes on
 
         self.assertTrue(self.set_fault(fault("robot_0", sensor_latency=0.5)).success)
         t1 = rospy.get_time() + 0.2
@@ -226,17 +238,20 @@ class SimServices(unittest.TestCase):
 
     # ---- pause, reset -------------------------------------------------------------------------
     def test_pause_stops_sim_time(self):
-        clock = Recorder("/clock", Clock)
-        clock.wait_for_first()
+        clock = []  # (wall receive time, sim time)
+        sub = rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.time(), m.clock.to_sec())))
+        wait_for_wall(lambda: clock, 10.0, "/clock")
         self.pause()
-        time.sleep(0.3)  # wall time on purpose: sim time stands still, so only wall time passes
-        before = clock.latest().clock.to_sec()
+        paused = time.time()
+        # Only wall time passes while paused: watch the clock for 1 s of it. A /clock sent just
+        # before the pause may still arrive (well within 0.2 s); nothing later.
         time.sleep(1.0)
-        self.assertEqual(clock.latest().clock.to_sec(), before, "sim time moved while paused")
+        late = [(round(w - paused, 3), t) for (w, t) in clock if w > paused + 0.2]
+        self.assertEqual(late, [], "sim time moved while paused: (wall s after the pause, sim time)")
+        before = clock[-1][1]
         self.unpause()
-        rospy.sleep(0.5)
-        self.assertGreater(clock.latest().clock.to_sec(), before + 0.4)
-        clock.sub.unregister()
+        wait_for_wall(lambda: clock[-1][1] > before + 0.4, 10.0, "sim time to go on after unpause")
+        sub.unregister()
 
     def test_zz_reset_puts_robots_back(self):
         pub = rospy.Publisher("/robot_2/cmd_vel", Twist, queue_size=10)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rostest: a user's move_base launch file (test/move_base_config/move_base.launch, tutorial-style
+"""rostest: a user's move_base launch file (test/fixtures/move_base_config/move_base.launch, tutorial-style
 parameter files for another robot, with navfn/NavfnROS and dwa_local_planner/DWAPlannerROS)
 runs our `move_base` executable after one change, pkg="mbot_navigation"; robot_0 reaches a goal
 through a door of the office."""

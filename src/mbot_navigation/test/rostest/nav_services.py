@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest: the nav node's services and action feedback, called as an outside client would
-(robot_0 in the office, test/worlds/nav_office.world.yaml): action feedback while driving,
+(robot_0 in the office, test/fixtures/worlds/nav_office.world.yaml): action feedback while driving,
 ~make_plan with and without its tolerance search, and ~clear_costmaps forgetting what the laser
 marked while the map stays.
 
@@ -47,6 +47,13 @@ class Costmap(object):
         i = int((x - m.info.origin.position.x) / m.info.resolution)
         j = int((y - m.info.origin.position.y) / m.info.resolution)
         return m.data[j * m.info.width + i]
+
+    def centre(self, x, y):
+        """The centre of the cell that holds (x, y). A beam aimed at a cell corner (such as the
+        round (-0.6, -3.0)) ends in any of four cells, as float32 ranges and angles round."""
+        m = self.msg
+        res, ox, oy = m.info.resolution, m.info.origin.position.x, m.info.origin.position.y
+        return (ox + (int((x - ox) / res) + 0.5) * res, oy + (int((y - oy) / res) + 0.5) * res)
 
     def after(self, n):
         """True once the n-th message after now has arrived."""
@@ -175,24 +182,26 @@ class NavServices(unittest.TestCase):
         tf_buffer = tf2_ros.Buffer()
         listener = tf2_ros.TransformListener(tf_buffer)  # noqa: F841 (kept while the test runs)
         scan_pub = rospy.Publisher("/%s/scan" % ROBOT, LaserScan, queue_size=5)
-        self.assertLess(costmap.value(*PHANTOM), 99, "(%.1f, %.1f) should be free before" % PHANTOM)
+        phantom = costmap.centre(*PHANTOM)
+        self.assertLess(costmap.value(*phantom), 99, "(%.3f, %.3f) should be free before" % phantom)
         wait_for_wall(lambda: scan_pub.get_num_connections() > 0, 30.0, "the nav node to take our scans")
         tf_buffer.lookup_transform("map", "%s/base_laser" % ROBOT, rospy.Time(0), rospy.Duration(30.0))
 
         def marked():
-            scan_pub.publish(phantom_scan(tf_buffer, *PHANTOM))
-            return costmap.value(*PHANTOM) == 100
+            scan_pub.publish(phantom_scan(tf_buffer, *phantom))
+            return costmap.value(*phantom) == 100
 
-        wait_until(marked, 60.0, "the extra beam's mark at (%.1f, %.1f) in the global costmap" % PHANTOM)
+        wait_until(marked, 60.0, "the extra beam's mark at (%.3f, %.3f) in the global costmap" % phantom,
+                   period=0.1)  # a scan per poll: at the laser's rate
         wait_until(costmap.after(2), 10.0, "two more global costmaps")
-        self.assertEqual(costmap.value(*PHANTOM), 100, "the mark should stay (no beam of the simulator gets there)")
+        self.assertEqual(costmap.value(*phantom), 100, "the mark should stay (no beam of the simulator gets there)")
 
         # --- clear_costmaps: the mark goes, the map's wall stays
         clear = rospy.ServiceProxy("/%s/move_base/clear_costmaps" % ROBOT, Empty)
         clear.wait_for_service(10.0)
         clear()
         wait_until(costmap.after(2), 10.0, "two more global costmaps")
-        self.assertLess(costmap.value(*PHANTOM), 99, "the mark at (%.1f, %.1f) is still there" % PHANTOM)
+        self.assertLess(costmap.value(*phantom), 99, "the mark at (%.3f, %.3f) is still there" % phantom)
         self.assertEqual(costmap.value(wall_x, wall_y), 100, "the map's wall went too")
 
 

@@ -6,6 +6,7 @@ import threading
 
 import rospy
 from actionlib_msgs.msg import GoalStatus
+from mbot_common.waits import wait_for_sim as wait_until  # noqa: F401 (the tests import it from here)
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import OccupancyGrid, Odometry
 
@@ -17,16 +18,6 @@ STATE_NAMES = {v: k for k, v in GoalStatus.__dict__.items() if k.isupper() and i
 
 def state_name(state):
     return STATE_NAMES.get(state, str(state))
-
-
-def wait_until(condition, timeout, what):
-    """Poll `condition` every 0.05 s of sim time for up to `timeout` sim seconds."""
-    deadline = rospy.Time.now() + rospy.Duration(timeout)
-    while not rospy.is_shutdown() and rospy.Time.now() < deadline:
-        if condition():
-            return
-        rospy.sleep(0.05)
-    raise AssertionError("timed out after %.0f sim s waiting for %s" % (timeout, what))
 
 
 def action_client(robot, timeout=60.0):

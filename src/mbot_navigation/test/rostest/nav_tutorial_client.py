@@ -75,8 +75,13 @@ class TutorialClient(unittest.TestCase):
     def test_2_move_base_simple_goal(self):
         track = Track("robot_1")
         statuses = {}  # goal id -> latest status
-        rospy.Subscriber("robot_1/move_base/status", GoalStatusArray,
-                         lambda m: statuses.update((s.goal_id.id, s.status) for s in m.status_list))
+        arrays = []  # every status message's sim time
+
+        def on_status(msg):
+            statuses.update((s.goal_id.id, s.status) for s in msg.status_list)
+            arrays.append(rospy.get_time())
+
+        rospy.Subscriber("robot_1/move_base/status", GoalStatusArray, on_status)
         pub = rospy.Publisher("robot_1/move_base_simple/goal", PoseStamped, queue_size=1, latch=True)
         track.wait()
         goal = PoseStamped()
@@ -87,7 +92,9 @@ class TutorialClient(unittest.TestCase):
         goal.pose.orientation.z = math.sin(math.pi / 4)
         goal.pose.orientation.w = math.cos(math.pi / 4)
         wait_until(lambda: pub.get_num_connections() > 0, 10.0, "the nav node to subscribe")
-        rospy.sleep(1.0)  # status messages of earlier goals
+        # A status message lists every goal the server still tracks: after the first one, the
+        # earlier goals are all in `statuses`.
+        wait_until(lambda: arrays, 10.0, "a message on robot_1/move_base/status")
         before = set(statuses)
         pub.publish(goal)
         new = lambda: {i: s for i, s in statuses.items() if i not in before}  # noqa: E731

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """rostest for map_server: /map, /map_metadata and /static_map against fixture maps.
 
-test/maps/fixture.pgm is 4 x 3 pixels (top row first in the file):
+test/fixtures/maps/fixture.pgm is 4 x 3 pixels (top row first in the file):
     0   255 255 128
     255 255 0   255
     255 128 255 0
