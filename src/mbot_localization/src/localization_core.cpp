@@ -44,6 +44,7 @@ void PfLocalizer::setInitialPose(const Pose2D& pose, const std::array<double, 9>
   initialized_ = true;
   has_estimate_ = false;
   force_update_ = true;
+  updates_since_init_ = 0;
 }
 
 bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan, const Pose2D& laser_in_base)
@@ -80,8 +81,10 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
   odom_at_estimate_ = odom_pose;
   has_estimate_ = true;
   ++updates_;
-  // the weights carry over between updates until the set is resampled
-  if (updates_ % config_.resample_interval == 0) filter_.resample();
+  ++updates_since_init_;
+  // the weights carry over between updates until the set is resampled (counted from the
+  // initialization: the first scan alone does not collapse a fresh set)
+  if (updates_since_init_ % config_.resample_interval == 0) filter_.resample();
   return true;
 }
 

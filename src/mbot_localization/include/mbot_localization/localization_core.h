@@ -101,6 +101,7 @@ private:
   PoseWithCovariance estimate_;
   Pose2D odom_at_estimate_;
   int updates_ = 0;
+  int updates_since_init_ = 0;
 };
 
 /// @brief Check every setting of `config` (the constructors of the filter and its models do).
