@@ -91,6 +91,24 @@ double LikelihoodField::distance(double x, double y) const
   return distance_[index(mx, my)];
 }
 
+double LikelihoodField::surfaceDistance(double x, double y) const
+{
+  // cell coordinates with 0 at the centre of cell 0
+  const double fx = (x - origin_x_) / resolution_ - 0.5;
+  const double fy = (y - origin_y_) / resolution_ - 0.5;
+  if (!(fx > -0.5 && fy > -0.5 && fx < width_ - 0.5 && fy < height_ - 0.5)) return max_distance_;
+  // the four cell centres around the point, clamped at the map's border
+  const int x0 = std::clamp(static_cast<int>(std::floor(fx)), 0, static_cast<int>(width_) - 1);
+  const int y0 = std::clamp(static_cast<int>(std::floor(fy)), 0, static_cast<int>(height_) - 1);
+  const int x1 = std::min(x0 + 1, static_cast<int>(width_) - 1);
+  const int y1 = std::min(y0 + 1, static_cast<int>(height_) - 1);
+  const double tx = std::clamp(fx - x0, 0.0, 1.0), ty = std::clamp(fy - y0, 0.0, 1.0);
+  const double bottom = (1.0 - tx) * cellDistance(x0, y0) + tx * cellDistance(x1, y0);
+  const double top = (1.0 - tx) * cellDistance(x0, y1) + tx * cellDistance(x1, y1);
+  const double d = (1.0 - ty) * bottom + ty * top;
+  return std::max(0.0, d - 0.5 * resolution_);
+}
+
 bool LikelihoodField::isFree(double x, double y) const
 {
   unsigned mx, my;

@@ -18,6 +18,8 @@ PfLocalizer::PfLocalizer(const PfLocalizerConfig& config, const OccupancyGridDat
 {
   if (!(config_.update_min_d >= 0.0) || !(config_.update_min_a >= 0.0))
     throw std::invalid_argument("update_min_d, update_min_a: expected >= 0");
+  if (!(config_.rest_d >= 0.0) || !(config_.rest_a >= 0.0))
+    throw std::invalid_argument("rest_d, rest_a: expected >= 0");
   if (config_.resample_interval < 1)
     throw std::invalid_argument("resample_interval: expected >= 1, got " + std::to_string(config_.resample_interval));
 }
@@ -42,19 +44,32 @@ void PfLocalizer::setInitialPose(const Pose2D& pose, const std::array<double, 9>
   initialized_ = true;
   has_estimate_ = false;
   force_update_ = true;
+  updates_since_init_ = 0;
 }
 
 bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan, const Pose2D& laser_in_base)
 {
   if (!initialized_) return false;
 
+  // standing still: no odometry change since the previous scan
+  const bool at_rest =
+      have_previous_scan_ &&
+      std::hypot(odom_pose.x - previous_scan_odom_.x, odom_pose.y - previous_scan_odom_.y) <= config_.rest_d &&
+      std::fabs(angleDiff(odom_pose.theta, previous_scan_odom_.theta)) <= config_.rest_a;
+  previous_scan_odom_ = odom_pose;
+  have_previous_scan_ = true;
+
   if (!force_update_)
   {
     // amcl's rule: update only after enough motion, so that a robot standing still does not
-    // collapse its particles onto one (possibly wrong) hypothesis
+    // collapse its particles onto one (possibly wrong) hypothesis. One update when it stops
+    // after a shorter move: otherwise the estimate where it stands (at a goal) is the one from
+    // up to update_min_d back, made while moving.
     const double moved = std::hypot(odom_pose.x - last_odom_.x, odom_pose.y - last_odom_.y);
     const double turned = std::fabs(angleDiff(odom_pose.theta, last_odom_.theta));
-    if (!(moved > config_.update_min_d || turned > config_.update_min_a)) return false;
+    const bool enough = moved > config_.update_min_d || turned > config_.update_min_a;
+    const bool settled = config_.update_at_rest && at_rest && (moved > config_.rest_d || turned > config_.rest_a);
+    if (!enough && !settled) return false;
     motion_.apply(last_odom_, odom_pose, filter_.particles(), filter_.rng());
   }
   force_update_ = false;
@@ -62,12 +77,14 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
 
   laser_.apply(scan, laser_in_base, filter_.particles());
   filter_.normalizeWeights();
-  estimate_ = filter_.estimate();
+  estimate_ = config_.cluster_estimate ? filter_.bestClusterEstimate() : filter_.estimate();
   odom_at_estimate_ = odom_pose;
   has_estimate_ = true;
   ++updates_;
-  // the weights carry over between updates until the set is resampled
-  if (updates_ % config_.resample_interval == 0) filter_.resample();
+  ++updates_since_init_;
+  // the weights carry over between updates until the set is resampled (counted from the
+  // initialization: the first scan alone does not collapse a fresh set)
+  if (updates_since_init_ % config_.resample_interval == 0) filter_.resample();
   return true;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace mbot_localization
@@ -151,22 +152,23 @@ std::vector<Beam> selectBeams(const LaserScanData& scan, const LaserModelConfig&
   return beams;
 }
 
-double scoreBeams(const std::vector<Beam>& beams, const Pose2D& laser_in_map, double range_max,
-                  const LaserModelConfig& config, const LikelihoodField& field)
+/// The log-likelihood of the beams seen from `laser_in_map` (see LikelihoodFieldModel::likelihood).
+double logScoreBeams(const std::vector<Beam>& beams, const Pose2D& laser_in_map, double range_max,
+                     const LaserModelConfig& config, const LikelihoodField& field)
 {
   const double two_sigma_sq = 2.0 * config.sigma_hit * config.sigma_hit;
   const double rand_part = range_max > 0.0 ? config.z_rand / range_max : 0.0;
-  double p = 1.0;
+  double sum = config.product ? 0.0 : 1.0;
   for (const Beam& b : beams)
   {
     const double angle = laser_in_map.theta + b.bearing;
     const double hx = laser_in_map.x + b.range * std::cos(angle);
     const double hy = laser_in_map.y + b.range * std::sin(angle);
-    const double d = field.distance(hx, hy);
+    const double d = config.surface_distance ? field.surfaceDistance(hx, hy) : field.distance(hx, hy);
     const double pz = config.z_hit * std::exp(-d * d / two_sigma_sq) + rand_part;
-    p += pz * pz * pz;
+    sum += config.product ? std::log(pz) : pz * pz * pz;
   }
-  return p;
+  return config.product ? sum : std::log(sum);
 }
 }  // namespace
 
@@ -175,11 +177,20 @@ double LikelihoodFieldModel::apply(const LaserScanData& scan, const Pose2D& lase
 {
   double range_max = 0.0;
   const std::vector<Beam> beams = selectBeams(scan, config_, range_max);
-  double total = 0.0;
-  for (Particle& particle : particles)
+  std::vector<double> log_p(particles.size());
+  double best = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < particles.size(); ++i)
   {
-    particle.weight *= scoreBeams(beams, compose(particle.pose, laser_in_base), range_max, config_, *field_);
-    total += particle.weight;
+    log_p[i] = logScoreBeams(beams, compose(particles[i].pose, laser_in_base), range_max, config_, *field_);
+    best = std::max(best, log_p[i]);
+  }
+  // A product of many beam scores underflows a double: scale all by the best particle's, which
+  // normalizing the weights cancels.
+  double total = 0.0;
+  for (size_t i = 0; i < particles.size(); ++i)
+  {
+    particles[i].weight *= std::exp(log_p[i] - best);
+    total += particles[i].weight;
   }
   return total;
 }
@@ -187,9 +198,15 @@ double LikelihoodFieldModel::apply(const LaserScanData& scan, const Pose2D& lase
 double LikelihoodFieldModel::likelihood(const LaserScanData& scan, const Pose2D& laser_in_base,
                                         const Pose2D& base_in_map) const
 {
+  return std::exp(logLikelihood(scan, laser_in_base, base_in_map));
+}
+
+double LikelihoodFieldModel::logLikelihood(const LaserScanData& scan, const Pose2D& laser_in_base,
+                                           const Pose2D& base_in_map) const
+{
   double range_max = 0.0;
   const std::vector<Beam> beams = selectBeams(scan, config_, range_max);
-  return scoreBeams(beams, compose(base_in_map, laser_in_base), range_max, config_, *field_);
+  return logScoreBeams(beams, compose(base_in_map, laser_in_base), range_max, config_, *field_);
 }
 
 }  // namespace mbot_localization

@@ -1,6 +1,8 @@
 #include "mbot_localization/particle_filter.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -113,12 +115,14 @@ void ParticleFilter::resample()
   particles_.swap(next);
 }
 
-PoseWithCovariance ParticleFilter::estimate() const
+PoseWithCovariance ParticleFilter::meanOf(const std::vector<bool>& member) const
 {
   PoseWithCovariance out;
   double total = 0.0, mx = 0.0, my = 0.0, mc = 0.0, ms = 0.0;
-  for (const Particle& p : particles_)
+  for (size_t i = 0; i < particles_.size(); ++i)
   {
+    if (!member[i]) continue;
+    const Particle& p = particles_[i];
     total += p.weight;
     mx += p.weight * p.pose.x;
     my += p.weight * p.pose.y;
@@ -131,8 +135,10 @@ PoseWithCovariance ParticleFilter::estimate() const
   mc /= total;
   ms /= total;
   double xx = 0.0, xy = 0.0, yy = 0.0;
-  for (const Particle& p : particles_)
+  for (size_t i = 0; i < particles_.size(); ++i)
   {
+    if (!member[i]) continue;
+    const Particle& p = particles_[i];
     const double dx = p.pose.x - mx, dy = p.pose.y - my;
     xx += p.weight * dx * dx;
     xy += p.weight * dx * dy;
@@ -148,6 +154,60 @@ PoseWithCovariance ParticleFilter::estimate() const
   const double r = std::hypot(mc, ms);
   out.covariance[8] = r > 0.0 ? -2.0 * std::log(std::min(1.0, r)) : 4.0 * M_PI * M_PI;
   return out;
+}
+
+PoseWithCovariance ParticleFilter::estimate() const { return meanOf(std::vector<bool>(particles_.size(), true)); }
+
+std::vector<size_t> ParticleFilter::clusters(size_t& count) const
+{
+  // bin of each particle; heading bins wrap around at +-pi
+  const int theta_bins = std::max(1, static_cast<int>(std::ceil(2.0 * M_PI / config_.bin_size_theta)));
+  std::map<std::array<int64_t, 3>, size_t> bin_index;
+  std::vector<size_t> bin_of(particles_.size());
+  for (size_t i = 0; i < particles_.size(); ++i)
+  {
+    const Pose2D& q = particles_[i].pose;
+    const std::array<int64_t, 3> key = {
+        static_cast<int64_t>(std::floor(q.x / config_.bin_size_xy)),
+        static_cast<int64_t>(std::floor(q.y / config_.bin_size_xy)),
+        static_cast<int64_t>(std::floor((q.theta + M_PI) / config_.bin_size_theta)) % theta_bins};
+    bin_of[i] = bin_index.emplace(key, bin_index.size()).first->second;
+  }
+  // union-find over bins: a bin joins every occupied one of its 26 neighbours
+  std::vector<size_t> parent(bin_index.size());
+  for (size_t b = 0; b < parent.size(); ++b) parent[b] = b;
+  const auto root = [&parent](size_t b) {
+    while (parent[b] != b) b = parent[b] = parent[parent[b]];
+    return b;
+  };
+  for (const auto& [key, b] : bin_index)
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int da = -1; da <= 1; ++da)
+        {
+          const std::array<int64_t, 3> next = {key[0] + dx, key[1] + dy, (key[2] + da + theta_bins) % theta_bins};
+          const auto it = bin_index.find(next);
+          if (it != bin_index.end()) parent[root(it->second)] = root(b);
+        }
+  std::map<size_t, size_t> number;  // root bin -> cluster number
+  std::vector<size_t> cluster(particles_.size());
+  for (size_t i = 0; i < particles_.size(); ++i)
+    cluster[i] = number.emplace(root(bin_of[i]), number.size()).first->second;
+  count = number.size();
+  return cluster;
+}
+
+PoseWithCovariance ParticleFilter::bestClusterEstimate() const
+{
+  size_t count = 0;
+  const std::vector<size_t> cluster = clusters(count);
+  if (count == 0) return PoseWithCovariance{};
+  std::vector<double> weight(count, 0.0);
+  for (size_t i = 0; i < particles_.size(); ++i) weight[cluster[i]] += particles_[i].weight;
+  const size_t best = static_cast<size_t>(std::max_element(weight.begin(), weight.end()) - weight.begin());
+  std::vector<bool> member(particles_.size());
+  for (size_t i = 0; i < particles_.size(); ++i) member[i] = cluster[i] == best;
+  return meanOf(member);
 }
 
 }  // namespace mbot_localization

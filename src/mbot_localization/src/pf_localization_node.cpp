@@ -66,12 +66,15 @@ private:
     config_.update_min_d = p.getDouble("update_min_d", config_.update_min_d);
     config_.update_min_a = p.getDouble("update_min_a", config_.update_min_a);
     config_.resample_interval = p.getInt("resample_interval", config_.resample_interval);
+    config_.update_at_rest = p.getBool("update_at_rest", config_.update_at_rest);
 
-    const std::string laser_model = p.getString("laser_model_type", "likelihood_field");
-    if (laser_model != "likelihood_field")
+    const std::string laser_model = p.getString("laser_model_type", "likelihood_field_prob");
+    if (laser_model != "likelihood_field" && laser_model != "likelihood_field_prob")
       throw std::runtime_error("parameter " + pnh.resolveName("laser_model_type") +
-                               ": only \"likelihood_field\" is implemented, got \"" + laser_model + "\"");
+                               ": expected \"likelihood_field\" or \"likelihood_field_prob\", got \"" + laser_model +
+                               "\"");
     LaserModelConfig& l = config_.laser;
+    l.product = laser_model == "likelihood_field_prob";
     l.z_hit = p.getDouble("laser_z_hit", l.z_hit);
     l.z_rand = p.getDouble("laser_z_rand", l.z_rand);
     l.sigma_hit = p.getDouble("laser_sigma_hit", l.sigma_hit);

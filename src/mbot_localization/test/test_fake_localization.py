@@ -20,6 +20,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
+from mbot_common.geometry import quaternion_from_yaw, yaw_of
 from mbot_common.waits import wait_for_wall as wait_for  # these tests publish /clock themselves
 
 PKG = "mbot_localization"
@@ -30,10 +31,6 @@ START_NS = 100 * 1000 * 1000 * 1000  # t = 100 s
 
 def stamp(ns):
     return rospy.Time(ns // 10**9, ns % 10**9)
-
-
-def quaternion_yaw(yaw):
-    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
 
 
 def homogeneous(x, y, z, q):
@@ -80,7 +77,7 @@ class FakeLocalizationTest(unittest.TestCase):
         msg.header.frame_id = frame
         msg.child_frame_id = child
         msg.pose.pose.position.x, msg.pose.pose.position.y = pose[0], pose[1]
-        q = quaternion_yaw(pose[2])
+        q = quaternion_from_yaw(pose[2])
         o = msg.pose.pose.orientation
         o.x, o.y, o.z, o.w = q
         publisher.publish(msg)
@@ -116,8 +113,8 @@ class FakeLocalizationTest(unittest.TestCase):
 
             gx, gy, gyaw = ground_truth(k)
             ox, oy, oyaw = odometry(k)
-            expected = homogeneous(gx, gy, 0.0, quaternion_yaw(gyaw)).dot(
-                np.linalg.inv(homogeneous(ox, oy, 0.0, quaternion_yaw(oyaw))))
+            expected = homogeneous(gx, gy, 0.0, quaternion_from_yaw(gyaw)).dot(
+                np.linalg.inv(homogeneous(ox, oy, 0.0, quaternion_from_yaw(oyaw))))
             error = np.abs(got - expected).max()
             worst = max(worst, error)
             self.assertLess(error, 1e-6, "step %d: got\n%s\nexpected\n%s" % (k, got, expected))
@@ -132,8 +129,7 @@ class FakeLocalizationTest(unittest.TestCase):
             self.assertAlmostEqual(msg.pose.pose.position.x, gx, places=9)
             self.assertAlmostEqual(msg.pose.pose.position.y, gy, places=9)
             o = msg.pose.pose.orientation
-            yaw = math.atan2(2.0 * (o.w * o.z + o.x * o.y), 1.0 - 2.0 * (o.y * o.y + o.z * o.z))
-            self.assertAlmostEqual(math.remainder(yaw - gyaw, 2.0 * math.pi), 0.0, places=9)
+            self.assertAlmostEqual(math.remainder(yaw_of(o) - gyaw, 2.0 * math.pi), 0.0, places=9)
 
 
 if __name__ == "__main__":

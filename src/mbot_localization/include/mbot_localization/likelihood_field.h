@@ -41,6 +41,15 @@ public:
   ///        maxDistance() off the map (amcl treats off-map beam endpoints the same way).
   double distance(double x, double y) const;
 
+  /// @brief Distance [m] from the point (x, y) to the nearest obstacle's surface (cell edge),
+  ///        interpolated between cell centres; 0 inside obstacles, maxDistance() off the map.
+  ///
+  /// distance() is a step function of cell size that is 0 at obstacle cell centres, half a cell
+  /// behind the surface that a laser sees: scored with it, the filter cannot place the robot
+  /// closer than about a cell and is pulled towards the walls. Bilinear interpolation of the
+  /// centre distances minus half a cell is continuous and 0 at a straight wall's surface.
+  double surfaceDistance(double x, double y) const;
+
   /// @brief Distance [m] stored for cell (mx, my); the cell must be inside the map.
   double cellDistance(unsigned mx, unsigned my) const { return distance_[index(mx, my)]; }
 

@@ -32,13 +32,22 @@ struct PfLocalizerConfig
   double update_min_a = M_PI / 6.0;  ///< update_min_a: rotation [rad] before a filter update
   int resample_interval = 2;         ///< resample_interval: filter updates per resampling
   double likelihood_max_dist = 2.0;  ///< laser_likelihood_max_dist [m]
+  /// update_at_rest (not in amcl): one more update when the robot stops after moving less than
+  /// the thresholds, so that where it stands is judged by a scan taken there
+  bool update_at_rest = true;
+  /// estimate: mean of the heaviest particle cluster (true, as amcl) or of the whole set
+  bool cluster_estimate = true;
+  double rest_d = 0.001;  ///< [m] odometry change between two scans that counts as standing still
+  double rest_a = 0.002;  ///< [rad]
 };
 
 /// @brief The AMCL-like localization cycle for one robot.
 ///
 /// Feed it every scan with the odometry pose of the base at the scan's time. The filter runs
-/// when the robot moved update_min_d or turned update_min_a since the last update, and once
-/// right after (re)initialization. Between updates mapToOdom() keeps the last correction.
+/// when the robot moved update_min_d or turned update_min_a since the last update, once right
+/// after (re)initialization, and (update_at_rest) once when the robot comes to rest after moving
+/// less than that. Between updates mapToOdom() keeps the last correction: the odometry carries
+/// the motion since then.
 class PfLocalizer
 {
 public:
@@ -87,9 +96,12 @@ private:
   bool has_estimate_ = false;
   bool force_update_ = false;  ///< set by setInitialPose: update on the next scan
   Pose2D last_odom_;           ///< odometry pose at the last filter update
+  Pose2D previous_scan_odom_;  ///< odometry pose at the previous scan
+  bool have_previous_scan_ = false;
   PoseWithCovariance estimate_;
   Pose2D odom_at_estimate_;
   int updates_ = 0;
+  int updates_since_init_ = 0;
 };
 
 /// @brief Check every setting of `config` (the constructors of the filter and its models do).

@@ -89,11 +89,16 @@ struct LaserModelConfig
   int max_beams = 30;       ///< laser_max_beams: beams used per scan (evenly spread)
   double min_range = -1.0;  ///< laser_min_range [m]; <= 0: use the scan's range_min
   double max_range = -1.0;  ///< laser_max_range [m]; <= 0: use the scan's range_max
+  /// laser_model_type likelihood_field_prob (true) or likelihood_field (false): how the beams'
+  /// scores combine, see LikelihoodFieldModel::likelihood()
+  bool product = true;
+  /// score by LikelihoodField::surfaceDistance (true) or amcl's cell distance (false)
+  bool surface_distance = true;
 };
 
 /// @brief Likelihood-field laser model (Probabilistic Robotics, table 6.3), as amcl's
-///        likelihood_field model: a beam end point at distance d from the nearest obstacle scores
-///        z_hit * exp(-d^2 / (2 sigma_hit^2)) + z_rand / range_max.
+///        likelihood_field and likelihood_field_prob models: a beam end point at distance d from
+///        the nearest obstacle scores p = z_hit * exp(-d^2 / (2 sigma_hit^2)) + z_rand / range_max.
 class LikelihoodFieldModel
 {
 public:
@@ -102,14 +107,20 @@ public:
 
   /// @brief Multiply every particle's weight by the likelihood of `scan` seen from it.
   /// @param laser_in_base the laser frame in the robot's base frame [m, m, rad]
-  /// @return the sum of the new weights
+  /// @return the sum of the new weights (all likelihoods are scaled by the best one's, so that
+  ///         many beams do not underflow; normalizing the weights cancels the scale)
   double apply(const LaserScanData& scan, const Pose2D& laser_in_base, std::vector<Particle>& particles) const;
 
   /// @brief The (unnormalized) likelihood of `scan` for one robot pose in the map.
   ///
-  /// As amcl, beam scores are combined as 1 + sum(p^3) instead of a product: a product of
-  /// hundreds of correlated beams makes the filter overconfident; the cube keeps the contrast.
+  /// With `product` (amcl's likelihood_field_prob) the beam scores multiply, as independent
+  /// beams do; laser_max_beams bounds how confident that makes the filter. Without it (amcl's
+  /// likelihood_field) they combine as 1 + sum(p^3): that score changes only a few per cent for a
+  /// pose a few centimetres off, so the particles hardly converge closer than that.
   double likelihood(const LaserScanData& scan, const Pose2D& laser_in_base, const Pose2D& base_in_map) const;
+
+  /// @brief log(likelihood()), without its overflow or underflow for many beams.
+  double logLikelihood(const LaserScanData& scan, const Pose2D& laser_in_base, const Pose2D& base_in_map) const;
 
   const LaserModelConfig& config() const { return config_; }
   const LikelihoodField& field() const { return *field_; }

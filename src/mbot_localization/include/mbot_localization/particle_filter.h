@@ -53,6 +53,15 @@ public:
   /// @brief Weighted mean pose and covariance of the set (circular mean for the heading).
   PoseWithCovariance estimate() const;
 
+  /// @brief Weighted mean pose and covariance of the heaviest cluster, as amcl reports: the
+  ///        particles are binned (ParticleFilterConfig's bins) and touching bins (also across
+  ///        the +-pi seam) form a cluster. When the set holds two hypotheses, the whole set's
+  ///        mean lies between them, where the robot is not.
+  PoseWithCovariance bestClusterEstimate() const;
+
+  /// @brief The cluster of each particle (see bestClusterEstimate()), numbered from 0.
+  std::vector<size_t> clusters(size_t& count) const;
+
   /// @brief Number of occupied bins (see ParticleFilterConfig) of the current set.
   size_t occupiedBins() const;
 
@@ -63,6 +72,8 @@ public:
 
 private:
   size_t countBins(const std::vector<size_t>& indices) const;
+  /// Weighted mean and covariance of the particles whose `member` flag is set.
+  PoseWithCovariance meanOf(const std::vector<bool>& member) const;
 
   ParticleFilterConfig config_;
   std::mt19937 rng_;

@@ -1,10 +1,11 @@
 """Talking to a robot's move_base from a script, a demo or a test: goals and the connection."""
-import math
 import time
 
 import actionlib
 import rospy
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+
+from mbot_common.geometry import quaternion_from_yaw
 
 
 def make_goal(x, y, yaw=0.0, frame="map"):
@@ -14,8 +15,8 @@ def make_goal(x, y, yaw=0.0, frame="map"):
     goal.target_pose.header.frame_id = frame
     goal.target_pose.pose.position.x = x
     goal.target_pose.pose.position.y = y
-    goal.target_pose.pose.orientation.z = math.sin(yaw / 2.0)
-    goal.target_pose.pose.orientation.w = math.cos(yaw / 2.0)
+    o = goal.target_pose.pose.orientation
+    o.x, o.y, o.z, o.w = quaternion_from_yaw(yaw)
     return goal
 
 

@@ -12,6 +12,7 @@ import rostest
 from actionlib_msgs.msg import GoalStatus
 from nav_msgs.msg import Odometry
 
+from mbot_common.geometry import yaw_of
 from nav_test_tools import Track, action_client, angle_diff, make_goal, run_goal, state_name
 
 ROBOT = "robot_0"
@@ -29,7 +30,7 @@ class Motion(object):
 
     def _on_odom(self, msg):
         q, v = msg.pose.pose.orientation, msg.twist.twist.linear
-        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        yaw = yaw_of(q)
         with self._lock:
             self.samples.append((msg.header.stamp.to_sec(), yaw, v.x, v.y))
 

@@ -21,6 +21,7 @@ from nav_msgs.srv import GetPlan, GetPlanRequest
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
+from mbot_common.geometry import yaw_of
 from mbot_common.waits import wait_for_wall
 from nav_test_tools import Track, action_client, make_goal, state_name, wait_until
 
@@ -82,9 +83,7 @@ def phantom_scan(tf_buffer, x, y):
     """A LaserScan of one beam from robot_0's laser to (x, y) in map, at the laser's latest pose."""
     t = tf_buffer.lookup_transform("map", "%s/base_laser" % ROBOT, rospy.Time(0), rospy.Duration(1.0))
     lx, ly = t.transform.translation.x, t.transform.translation.y
-    q = t.transform.rotation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-    bearing = math.atan2(y - ly, x - lx) - yaw
+    bearing = math.atan2(y - ly, x - lx) - yaw_of(t.transform.rotation)
     scan = LaserScan()
     scan.header.frame_id = "%s/base_laser" % ROBOT
     scan.header.stamp = t.header.stamp

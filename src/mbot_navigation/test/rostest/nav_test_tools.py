@@ -6,6 +6,7 @@ import threading
 
 import rospy
 from actionlib_msgs.msg import GoalStatus
+from mbot_common.geometry import yaw_of
 from mbot_common.waits import wait_for_sim as wait_until  # noqa: F401 (the tests import it from here)
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import OccupancyGrid, Odometry
@@ -51,7 +52,7 @@ class Track(object):
 
     def _on_odom(self, msg):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
-        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        yaw = yaw_of(q)
         with self._lock:
             if self.pose is not None:
                 self.length += math.hypot(p.x - self.pose[0], p.y - self.pose[1])
