@@ -58,9 +58,13 @@ def count(path):
     return passed, failed, skipped, failures
 
 
-def message_tail(text, lines=8):
+def message_tail(text, first=2, last=6):
+    """The first lines of a failure's text (rosunit puts the assertion message there) and its
+    last ones (a traceback's innermost frame, or pytest's message)."""
     kept = [line.rstrip() for line in text.strip().splitlines() if line.strip()]
-    return kept[-lines:]
+    if len(kept) <= first + last:
+        return kept
+    return kept[:first] + ["..."] + kept[-last:]
 
 
 def main(dirs):
