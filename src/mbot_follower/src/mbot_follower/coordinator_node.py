@@ -45,10 +45,11 @@ def _robots_from_params():
     if not world:
         raise ValueError("set ~robots (a list of names) or ~world (a world name or file)")
     import rospkg
-    from mbot_navigation.fleet_launch import find_maps_directory, read_world
+    from mbot_common.paths import find_maps_directory, resolve_world
+    from mbot_common.world import load_world
 
     maps = find_maps_directory(rospkg.RosPack().get_path("mbot_follower"))
-    return [r.name for r in read_world(world, maps).robots]
+    return [r.name for r in load_world(resolve_world(world, maps)).robots]
 
 
 class CoordinatorNode(object):

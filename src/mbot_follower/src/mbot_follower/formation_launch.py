@@ -9,8 +9,8 @@ comes back rejoins as a follower).
 """
 from xml.sax.saxutils import quoteattr
 
-from mbot_navigation.fleet_launch import (LOCALIZATIONS, find_maps_directory, fleet_launch_xml, read_world,
-                                          run_launch_text)
+from mbot_common.paths import find_maps_directory
+from mbot_navigation.fleet_launch import LOCALIZATIONS, fleet_launch_xml, read_world, run_launch_text
 
 OMNI_MODELS = ("mbot_omni",)
 

@@ -8,8 +8,9 @@ import pytest
 PACKAGE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))  # as the devel space would
 
+from mbot_common.paths import find_maps_directory  # noqa: E402
 from mbot_common.strict_yaml import ConfigError  # noqa: E402
-from mbot_navigation.fleet_launch import find_maps_directory, fleet_launch_xml, read_world  # noqa: E402
+from mbot_navigation.fleet_launch import fleet_launch_xml, read_world  # noqa: E402
 
 MAPS_DIR = os.path.abspath(os.path.join(PACKAGE_DIR, "..", "..", "maps"))
 OFFICE_MAP = os.path.join(MAPS_DIR, "office.yaml")
