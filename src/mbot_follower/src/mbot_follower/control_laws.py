@@ -75,7 +75,8 @@ class ControllerConfig(object):
         self.slot_tolerance = 0.1          # closer than this to a still slot = in the slot: face the leader's way [m]
         self.safety_distance = 0.8         # stop if something is closer than this ahead [m]
         self.safety_half_angle = math.radians(30)  # half-width of "ahead" [rad]
-        self.safety_near_distance = 0.45   # stop if something is this close on the side it drives to [m]
+        self.safety_near_distance = 0.45   # length of the lane ahead that must be clear [m]
+        self.safety_lane_half_width = 0.25  # the lane's half-width: robot radius 0.15 + 0.1 margin [m]
         self.yield_after = 1.0             # held by the safety layer this long: give way [s]
         self.yield_stagger = 0.5           # ... plus this per follower slot farther back than its own [s]
         self.yield_time = 1.5              # how long to back away from what holds it [s]
@@ -101,6 +102,7 @@ class ControllerConfig(object):
         "safety_distance": (float, lambda v: v >= 0, ">= 0"),
         "safety_half_angle": (float, lambda v: 0 <= v <= math.pi, "in [0, pi] [rad]"),
         "safety_near_distance": (float, lambda v: v >= 0, ">= 0"),
+        "safety_lane_half_width": (float, lambda v: v >= 0, ">= 0"),
         "yield_after": (float, lambda v: v >= 0, ">= 0"),
         "yield_stagger": (float, lambda v: v >= 0, ">= 0"),
         "yield_time": (float, lambda v: v >= 0, ">= 0"),
@@ -275,18 +277,38 @@ def safety_stop(ranges, angle_min, angle_increment, distance, half_angle):
     return False
 
 
+def lane_blocked(ranges, angle_min, angle_increment, length, half_width):
+    """True if a laser point lies in the lane the robot's body sweeps next: ahead of it (0 < x <
+    `length` [m]) and less than `half_width` [m] to either side (|y|), in a frame whose x axis
+    is the direction of travel. -Inf (too close to measure) on the front half counts; NaN and
+    +Inf do not."""
+    for i, r in enumerate(ranges):
+        a = normalize_angle(angle_min + i * angle_increment)
+        if math.isnan(r) or abs(a) > math.pi / 2:
+            continue
+        if r == float("-inf"):
+            return True
+        if math.isfinite(r) and 0.0 < r * math.cos(a) < length and abs(r * math.sin(a)) < half_width:
+            return True
+    return False
+
+
 def safety_filter(cmd, ranges, angle_min, angle_increment, config):
     """The safety layer, last in the loop: (cmd, stopped). The robot stops its travel (keeps
-    turning) when the laser sees something closer than `safety_distance` within
-    +-`safety_half_angle` of the direction it drives in (ahead, behind when backing up, sideways
-    for an omni robot), or closer than `safety_near_distance` anywhere on that side (+-90 deg),
-    which catches a robot coming in from the side."""
+    turning) when the laser sees something in the direction it drives in (ahead, behind when
+    backing up, sideways for an omni robot):
+    - closer than `safety_distance` within +-`safety_half_angle` of that direction, or
+    - in the lane its body sweeps next: within `safety_near_distance` ahead and less than
+      `safety_lane_half_width` to either side of its path (catches a corner at its shoulder).
+    Something beside the robot, outside that lane, does not stop it: driving on does not bring
+    it closer. Stopping for it held followers in doorways, beside the jambs, for ever."""
     speed = math.hypot(cmd.vx, cmd.vy)
     if speed < 1e-6:
         return cmd, False
     start = angle_min - math.atan2(cmd.vy, cmd.vx)   # beam angles relative to the travel direction
     if safety_stop(ranges, start, angle_increment, config.safety_distance, config.safety_half_angle) or \
-            safety_stop(ranges, start, angle_increment, config.safety_near_distance, math.pi / 2):
+            lane_blocked(ranges, start, angle_increment, config.safety_near_distance,
+                         config.safety_lane_half_width):
         return Twist2D(0.0, 0.0, cmd.wz), True
     return cmd, False
 

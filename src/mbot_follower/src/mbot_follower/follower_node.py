@@ -15,8 +15,9 @@ Every control period (sim time) it
    through doors, and the follower rejoins its slot once the way is clear again;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
-   than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or closer
-   than ``safety_near_distance`` on that side, stops the robot's travel;
+   than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
+   the lane the body sweeps next (``safety_near_distance`` long, +-``safety_lane_half_width``
+   wide), stops the robot's travel;
 5. publishes ``cmd_vel``, ``power`` (the energy model's rate) and ``~state`` (FollowerState).
 
 While its robot leads (the assignment names it), the node publishes no command: the robot's

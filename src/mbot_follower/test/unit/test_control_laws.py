@@ -309,8 +309,10 @@ def test_main_runs_without_plotting(args, kind, capsys):
     (Twist2D(0.3, 0.0, 0.2), 0, 0.9, False),       # ahead, beyond
     (Twist2D(0.3, 0.0, 0.2), 180, 0.3, False),     # behind a robot driving forwards
     (Twist2D(-0.1, 0.0, 0.0), 180, 0.7, True),     # behind a robot backing up
-    (Twist2D(0.3, 0.0, 0.0), 70, 0.4, True),       # close on the side it drives to
-    (Twist2D(0.3, 0.0, 0.0), 70, 0.6, False),      # beside, but not that close
+    (Twist2D(0.3, 0.0, 0.0), 45, 0.3, True),       # at its shoulder, in the lane it sweeps
+    (Twist2D(0.3, 0.0, 0.0), 70, 0.4, False),      # beside it (0.38 m aside): a door jamb it passes
+    (Twist2D(0.3, 0.0, 0.0), 100, 0.2, False),     # close, but behind its side: driving on moves away
+    (Twist2D(0.3, 0.0, 0.0), 60, float("-inf"), True),  # too close to measure, on the front half
     (Twist2D(0.0, 0.3, 0.0), 90, 0.7, True),       # omni driving left, something left
     (Twist2D(0.0, 0.0, 1.0), 0, 0.2, False),       # turning on the spot is never stopped
 ])
@@ -325,6 +327,30 @@ def test_safety_filter_looks_where_the_robot_drives(cmd, obstacle_at_deg, distan
         assert (out.vx, out.vy, out.wz) == (0.0, 0.0, cmd.wz)
     else:
         assert out == cmd
+
+
+def test_a_robot_drives_on_through_a_door_but_stops_before_its_jamb():
+    """A door 0.9 m wide in a wall across the way, robot centred 0.2 m before it: the jambs lie
+    beside its lane and it drives on. Shifted 0.3 m to the side, a jamb lies in its lane: stop."""
+    from mbot_follower.control_laws import lane_blocked
+    n = 720
+    inc = 2 * math.pi / n
+
+    def wall_with_door(offset):
+        ranges = []
+        for i in range(n):
+            a = -math.pi + i * inc
+            c = math.cos(a)
+            if c <= 1e-9:
+                ranges.append(float("inf"))
+                continue
+            r = 0.2 / c                      # the wall is 0.2 m ahead
+            y = r * math.sin(a) + offset     # where the beam meets it, relative to the door centre
+            ranges.append(r if abs(y) > 0.45 and r < 10.0 else float("inf"))
+        return ranges
+
+    assert not lane_blocked(wall_with_door(0.0), -math.pi, inc, 0.45, 0.25)
+    assert lane_blocked(wall_with_door(0.3), -math.pi, inc, 0.45, 0.25)
 
 
 def test_give_way_backs_away_after_being_held_the_one_further_back_first():
