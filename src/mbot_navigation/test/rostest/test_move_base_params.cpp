@@ -1,7 +1,9 @@
 // The nav node's parameter reader (move_base_params.h) on a parameter server (rostest
 // move_base_params.test): a tutorial-style move_base set loads with warnings only, each naming
-// its key; a key nobody knows is an error naming it; the plugins form picks the layers.
+// its key; a key nobody knows is an error naming it; the plugins form picks the layers; the
+// shipped costmaps (layered) resolve exactly as their pre-layer (flat) form.
 #include <algorithm>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -257,6 +259,96 @@ TEST(MoveBaseParams, FootprintRadius)
   EXPECT_THROW(footprintRadius(two, "f"), std::runtime_error);
   XmlRpc::XmlRpcValue bad("[[0.1, x]]");
   EXPECT_THROW(footprintRadius(bad, "f"), std::runtime_error);
+}
+
+namespace
+{
+/// The fields in which `a` and `b` differ, each as "name: a vs b" (empty: the same settings).
+std::vector<std::string> differences(const CostmapRosSettings& a, const CostmapRosSettings& b)
+{
+  std::vector<std::string> out;
+  auto compare = [&](const std::string& name, const auto& x, const auto& y) {
+    if (x == y) return;
+    std::ostringstream text;
+    text << name << ": " << x << " vs " << y;
+    out.push_back(text.str());
+  };
+  auto order = [](const std::vector<LayerKind>& layers) {
+    std::string text;
+    for (LayerKind k : layers) text += std::to_string(static_cast<int>(k)) + " ";
+    return text;
+  };
+  compare("global_frame", a.global_frame, b.global_frame);
+  compare("robot_base_frame", a.robot_base_frame, b.robot_base_frame);
+  compare("update_frequency", a.update_frequency, b.update_frequency);
+  compare("publish_frequency", a.publish_frequency, b.publish_frequency);
+  compare("transform_tolerance", a.transform_tolerance, b.transform_tolerance);
+  compare("costmap.rolling_window", a.costmap.rolling_window, b.costmap.rolling_window);
+  compare("costmap.width", a.costmap.width, b.costmap.width);
+  compare("costmap.height", a.costmap.height, b.costmap.height);
+  compare("costmap.resolution", a.costmap.resolution, b.costmap.resolution);
+  compare("costmap.origin_x", a.costmap.origin_x, b.costmap.origin_x);
+  compare("costmap.origin_y", a.costmap.origin_y, b.costmap.origin_y);
+  compare("costmap.track_unknown_space", a.costmap.track_unknown_space, b.costmap.track_unknown_space);
+  compare("costmap.robot_radius", a.costmap.robot_radius, b.costmap.robot_radius);
+  compare("static_map", a.static_map, b.static_map);
+  compare("map_topic", a.map_topic, b.map_topic);
+  compare("static_layer.track_unknown_space", a.static_layer.track_unknown_space, b.static_layer.track_unknown_space);
+  compare("static_layer.lethal_cost_threshold", a.static_layer.lethal_cost_threshold,
+          b.static_layer.lethal_cost_threshold);
+  compare("static_layer.unknown_cost_value", a.static_layer.unknown_cost_value, b.static_layer.unknown_cost_value);
+  compare("static_layer.trinary_costmap", a.static_layer.trinary_costmap, b.static_layer.trinary_costmap);
+  compare("scan_topic", a.scan_topic, b.scan_topic);
+  compare("obstacle_layer.obstacle_range", a.obstacle_layer.obstacle_range, b.obstacle_layer.obstacle_range);
+  compare("obstacle_layer.raytrace_range", a.obstacle_layer.raytrace_range, b.obstacle_layer.raytrace_range);
+  compare("obstacle_layer.track_unknown_space", a.obstacle_layer.track_unknown_space,
+          b.obstacle_layer.track_unknown_space);
+  compare("obstacle_layer.footprint_clearing_enabled", a.obstacle_layer.footprint_clearing_enabled,
+          b.obstacle_layer.footprint_clearing_enabled);
+  compare("inflation", a.inflation, b.inflation);
+  compare("inflation_layer.inflation_radius", a.inflation_layer.inflation_radius, b.inflation_layer.inflation_radius);
+  compare("inflation_layer.cost_scaling_factor", a.inflation_layer.cost_scaling_factor,
+          b.inflation_layer.cost_scaling_factor);
+  compare("inflation_layer.inflate_unknown", a.inflation_layer.inflate_unknown, b.inflation_layer.inflate_unknown);
+  compare("inflation_layer_name", a.inflation_layer_name, b.inflation_layer_name);
+  compare("robots_layer", a.robots_layer, b.robots_layer);
+  compare("robots.prediction_time", a.robots.prediction_time, b.robots.prediction_time);
+  compare("robots.prediction_step", a.robots.prediction_step, b.robots.prediction_step);
+  compare("robots.prediction_cost", int(a.robots.prediction_cost), int(b.robots.prediction_cost));
+  compare("robots_padding", a.robots_padding, b.robots_padding);
+  compare("robots_scan_margin", a.robots_scan_margin, b.robots_scan_margin);
+  compare("layer_order", order(a.layer_order), order(b.layer_order));
+  return out;
+}
+}  // namespace
+
+TEST(MoveBaseParams, ShippedLayeredCostmapsResolveAsTheirFlatForm)
+{
+  // config/nav_costmaps.yaml lists its layers with `plugins`; its flat twin does not.
+  ASSERT_TRUE(ros::param::has("/shipped/move_base/global_costmap/plugins"));
+  ASSERT_TRUE(ros::param::has("/shipped/move_base/local_costmap/plugins"));
+  ASSERT_FALSE(ros::param::has("/flat/move_base/global_costmap/plugins"));
+  ASSERT_FALSE(ros::param::has("/flat/move_base/local_costmap/plugins"));
+
+  ParamWarnings shipped_warnings, flat_warnings;
+  NavParams shipped, flat;
+  ASSERT_NO_THROW(shipped = read("shipped", shipped_warnings));
+  ASSERT_NO_THROW(flat = read("flat", flat_warnings));
+  EXPECT_EQ(shipped_warnings, ParamWarnings{});  // the node starts without a warning
+  EXPECT_EQ(flat_warnings, ParamWarnings{});
+
+  for (const std::string& d : differences(shipped.global_costmap, flat.global_costmap))
+    ADD_FAILURE() << "global_costmap " << d << " (shipped vs flat)";
+  for (const std::string& d : differences(shipped.local_costmap, flat.local_costmap))
+    ADD_FAILURE() << "local_costmap " << d << " (shipped vs flat)";
+
+  // The comparison sees a change in any one field (here: two that only the layers' namespaces set).
+  CostmapRosSettings changed = shipped.local_costmap;
+  changed.robots_padding += 0.05;
+  changed.layer_order.pop_back();
+  EXPECT_EQ(differences(shipped.local_costmap, changed).size(), 2u);
+  // And the two costmaps do differ from each other (a rolling window around the robot).
+  EXPECT_FALSE(differences(shipped.global_costmap, shipped.local_costmap).empty());
 }
 
 int main(int argc, char** argv)
