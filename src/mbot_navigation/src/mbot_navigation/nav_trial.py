@@ -236,8 +236,14 @@ class Lane(object):
         self.goal = None     # the goal it drives to (x, y, yaw), None when idle
         self.started = None  # sim time the goal was sent
         self.cancelled = None
+        self.ended = None    # the goal's final state, set when its result has arrived
         self.contacts_before = 0
         self.replaced = False
+
+    def on_done(self, state, result):
+        """done_cb: the result has arrived. Only then may the next goal go out: a result that
+        comes in after send_goal replaced the handle makes actionlib log an ERROR."""
+        self.ended = state
 
     def claim(self):
         """The point the other robots' goals keep away from: its goal, or where it stands."""
@@ -253,8 +259,6 @@ def drive(args, log, process=None):
 
     from mbot_navigation.move_base_client import connect_move_base, make_goal
 
-    ENDED = (GoalStatus.PREEMPTED, GoalStatus.SUCCEEDED, GoalStatus.ABORTED, GoalStatus.REJECTED,
-             GoalStatus.RECALLED, GoalStatus.LOST)
     wait_for_sim_time("nav_trial", args.launch_log)
     rospy.init_node("nav_trial", disable_signals=True)
     robots = trial_robots(args)
@@ -305,17 +309,17 @@ def drive(args, log, process=None):
                 lane.goal, lane.replaced = pick_goal(lane.goals[lane.next], lane.spares, claims,
                                                      args.goal_separation)
                 lane.next += 1
-                lane.started, lane.cancelled, lane.contacts_before = now, None, len(contacts)
-                lane.client.send_goal(make_goal(*lane.goal))
+                lane.started, lane.cancelled, lane.ended, lane.contacts_before = now, None, None, len(contacts)
+                lane.client.send_goal(make_goal(*lane.goal), done_cb=lane.on_done)
                 continue
-            done = lane.client.get_state() in ENDED
+            done = lane.ended is not None
             elapsed = (now - lane.started).to_sec()
             if not done and lane.cancelled is None and elapsed > args.timeout:
                 lane.client.cancel_goal()
                 lane.cancelled = now
             if not done and not (lane.cancelled is not None and (now - lane.cancelled).to_sec() > 5.0):
                 continue
-            state = lane.client.get_state()
+            state = lane.ended if done else lane.client.get_state()
             x, y, yaw = lane.goal
             succeeded, why = judge(state == GoalStatus.SUCCEEDED, elapsed, args.timeout, lane.pose, (x, y),
                                    lane.tolerance)
