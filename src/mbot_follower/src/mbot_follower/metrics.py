@@ -14,8 +14,11 @@ into the same Run, so a report computes the same summary offline. Nothing here k
 
 What the numbers mean (all times sim time unless marked wall):
   slot error        distance of a follower's ground-truth position from its slot, the slot being
-                    leader pose (+) offset of the current assignment. A lost robot (in the
-                    status' `lost`) is excluded while lost; so is a robot without a fresh pose.
+                    leader pose (+) offset of the current assignment; for a formation along the
+                    path (a column) the slot on the leader's ground-truth path since the
+                    assignment (trail.path_slot), and the heading errors are to each slot's
+                    heading. A lost robot (in the status' `lost`) is excluded while lost; so is
+                    a robot without a fresh pose.
   fit error         the same after the best rigid fit (rotation + translation) of the desired
                     shape onto the actual positions (shape.rigid_fit): the shape alone.
   slot free         whether a follower's slot keeps slot_clearance to the walls of the map (1/0;
@@ -62,8 +65,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from mbot_common.geometry import transform_point
 from mbot_follower.shape import ShapeErrors, rigid_fit, shape_errors
+from mbot_follower.trail import Trail, slot_pose
 
 NAN = float("nan")
 PLAN_STATES = ("NAVIGATING", "DEGRADED")   # the leader follows its global plan
@@ -184,6 +187,10 @@ class MetricsCollector(object):
         self._assignments = []
         self._statuses = []
         self._next_tick = None   # the next sample is at _next_tick / rate [s]
+        # The leader's ground-truth path at the sample times since the assignment in force
+        # (_trail_of), for the slots of a formation along the path.
+        self._trail = Trail()
+        self._trail_of = None
 
     def _know(self, robot):
         if robot not in self.distance:
@@ -317,7 +324,7 @@ class MetricsCollector(object):
         at_t = {r: p for r, p in at_t.items() if p is not None and t - p[0] <= self.config.stale_after}
         fresh = {r: p[1:4] for r, p in at_t.items()}
         entry = self._in_force(self._assignments, t)
-        a = entry[1] if entry is not None else None
+        a, entry_t = (entry[1], entry[0]) if entry is not None else (None, None)
         entry = self._in_force(self._statuses, t)
         state, lost = (entry[1], entry[2]) if entry is not None else ("", ())
         slot_error, fit_error, slot_free = {}, {}, {}
@@ -326,12 +333,16 @@ class MetricsCollector(object):
         leader = a.leader if a is not None else ""
         if a is not None and leader in fresh and leader not in lost:
             lx, ly, lth = fresh[leader]
+            self._follow_leader(a, entry_t, leader, (lx, ly, lth))
+            trail = self._trail if getattr(a, "along_path", False) else None
             followers = sorted(r for r in a.slots if r != leader and r not in lost and r in fresh)
             if followers:
                 actual = [(lx, ly)] + [fresh[r][:2] for r in followers]
-                desired = [transform_point((lx, ly, lth), *a.slots.get(leader, (0.0, 0.0)))]
-                desired += [transform_point((lx, ly, lth), *a.slots[r]) for r in followers]
-                errors = shape_errors(actual, desired, headings=[lth] + [fresh[r][2] for r in followers])
+                slots = [slot_pose((lx, ly, lth), a.slots.get(leader, (0.0, 0.0)), trail)]
+                slots += [slot_pose((lx, ly, lth), a.slots[r], trail) for r in followers]
+                desired = [(p.x, p.y) for p in slots]
+                errors = shape_errors(actual, desired, headings=[lth] + [fresh[r][2] for r in followers],
+                                      desired_headings=[p.theta for p in slots])
                 _, _, fitted = rigid_fit(actual, desired)
                 for i, r in enumerate(followers, start=1):
                     slot_error[r] = math.hypot(actual[i][0] - desired[i][0], actual[i][1] - desired[i][1])
@@ -360,6 +371,15 @@ class MetricsCollector(object):
         return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)
+
+    def _follow_leader(self, a, since, leader, pose):
+        """Record the leader's pose on its trail; a new assignment `a` (in force since `since`)
+        starts the trail where the leader was then."""
+        if a is not self._trail_of:
+            start = self._pose_at(leader, since)
+            self._trail.start(*(start[1:4] if start is not None else pose))
+            self._trail_of = a
+        self._trail.add(pose[0], pose[1])
 
     def summary(self):
         return summarize(self.run)

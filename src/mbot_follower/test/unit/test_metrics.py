@@ -476,3 +476,31 @@ def test_a_run_recorded_before_slot_free_reads_as_unknown(tmp_path):
     assert all(math.isnan(rs.slot_free) for s in back.samples for rs in s.robots.values())
     assert summarize(back)["fleet"]["steady_navigating_slot_rms_m"] == \
         summarize(c.run)["fleet"]["steady_navigating_slot_rms_m"]
+
+
+def l_path(s):
+    """(x, y, theta) at arc length s [m] of an L: 1.5 m along +x from (0, 0), then along +y
+    (s < 0: straight on behind the start)."""
+    return (s, 0.0, 0.0) if s <= 1.5 else (1.5, s - 1.5, math.pi / 2)
+
+
+@pytest.mark.parametrize("along_path", [True, False])
+def test_a_column_on_its_path_slots_around_a_corner_has_no_slot_error(along_path):
+    column = {"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0), "robot_2": (-2.0, 0.0)}
+    c = MetricsCollector()
+    c.on_assignment(0.0, Assignment("robot_0", "column", 1.0, column, {r: "robot_0" for r in column},
+                                    along_path))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    # the leader drives the L at 1 m/s; each follower exactly where the leader was 1 m / 2 m before
+    drive(c, 0.0, 3.0, lambda t: {r: l_path(t + x) for r, (x, _) in column.items()})
+    s = summarize(c.run)
+    last = c.run.samples[-1]            # t = 2.9: the leader at (1.5, 1.4), robot_2 at (0.9, 0)
+    assert last.t == pytest.approx(2.9) and last.robots["robot_2"].x == pytest.approx(0.9)
+    if along_path:
+        assert s["fleet"]["slot_max_m"] < 1e-9
+        assert s["fleet"]["steady_navigating_slot_rms_m"] < 1e-9
+        assert last.heading_max < 1e-9  # each robot faces the way of the path where it is
+    else:
+        # rigid slots swing around the corner: robot_2's is at (1.5, -0.6), 0.85 m away
+        assert last.robots["robot_2"].slot_error == pytest.approx(math.hypot(0.6, 0.6))
+        assert last.heading_max == pytest.approx(math.pi / 2)
