@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from mbot_bringup.report_data import Series, arrival_time, assignment_at, assignments, event_marks, \
-    fleet_path_length, slot_positions, speeds, state_spans
+    fleet_path_length, leader_trail, slot_positions, speeds, state_spans
 
 
 class PlotStyle(object):
@@ -419,7 +419,8 @@ def write_animation(run, world, colors, path, radius):
             t = series.t[i]
             leader_name = series.leader[i]
             leader = series.pose(leader_name, i)
-            slots = slot_positions(assignment_at(assigned, t + series.t0), leader)
+            a = assignment_at(assigned, t + series.t0)
+            slots = slot_positions(a, leader, leader_trail(series, a, i) if a is not None and a.along_path else None)
             recent = (series.t >= t - STYLE.trail) & (series.t <= t)
             for r, (trail, slot, error, link, disc, tick, name) in artists.items():
                 pose = series.pose(r, i)

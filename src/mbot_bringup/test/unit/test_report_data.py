@@ -171,3 +171,31 @@ def test_events_to_mark_on_the_time_axes():
     assert [(m.t, m.kind, m.label) for m in event_marks(run)] == [
         (2.0, "pause", "pause"), (3.0, "loss", "lost follower_2"), (4.0, "rejoin", "follower_2 back"),
         (5.0, "contact", "contact follower_1-map"), (6.0, "fault", "fault follower_1")]
+
+
+def test_a_column_along_the_path_has_its_slots_on_the_leaders_path():
+    from mbot_bringup.report_data import leader_trail
+    from mbot_follower.fleet_io import Assignment
+    from mbot_follower.metrics import MetricsCollector
+
+    def l_path(s):   # 1.5 m along +x from (0, 0), then along +y
+        return (s, 0.0, 0.0) if s <= 1.5 else (1.5, s - 1.5, math.pi / 2)
+
+    column = {"L": (0.0, 0.0), "a": (-1.0, 0.0), "b": (-2.0, 0.0)}
+    c = MetricsCollector()
+    c.on_assignment(0.0, Assignment("L", "column", 1.0, column, {r: "L" for r in column}, True))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    for k in range(150):                  # the leader drives the L at 1 m/s, the column on its path
+        t = k / 50.0
+        for r, (x, _) in column.items():
+            c.on_pose(r, t, *l_path(t + x))
+    a = assignments(c.run)[0]
+    assert a.along_path and a.slots == column
+    series = Series(c.run)
+    i = len(series.t) - 1                 # t = 2.9 s: a at (1.5, 0.4), b at (0.9, 0) before the corner
+    leader = series.pose("L", i)
+    on_path = slot_positions(a, leader, leader_trail(series, a, i))
+    for r in ("a", "b"):
+        assert on_path[r] == pytest.approx(series.pose(r, i)[:2], abs=1e-9)
+    rigid = slot_positions(a, leader)      # no trail: rigid slots, b's 0.85 m off
+    assert math.hypot(rigid["b"][0] - 0.9, rigid["b"][1]) == pytest.approx(math.hypot(0.6, 0.6))

@@ -84,7 +84,7 @@ Sample = namedtuple("Sample", "t state leader formation lost slot_rms slot_max f
                               "edge_max heading_max leader_lateral min_clearance clearance_pair robots")
 
 #: Something that happened at t [s]. kind / name / detail:
-#:   state / new state / reason        assignment / formation / "leader L spacing S m slots ..."
+#:   state / new state / reason        assignment / formation / "leader L spacing S m [along_path] slots ..."
 #:   switch / new formation / old one  loss, rejoin / robot / ""
 #:   contact / body_a / body_b, at x, y [m] (NaN for the other kinds)
 Event = namedtuple("Event", "t kind name detail x y")
@@ -253,8 +253,9 @@ class MetricsCollector(object):
             self._know(robot)
         slots = " ".join("%s(%g,%g)" % (r, assignment.slots[r][0], assignment.slots[r][1])
                          for r in sorted(assignment.slots))
-        self.run.events.append(Event(t, "assignment", assignment.formation, "leader %s spacing %g m slots %s"
-                                     % (assignment.leader, assignment.spacing, slots), NAN, NAN))
+        path = " along_path" if getattr(assignment, "along_path", False) else ""
+        self.run.events.append(Event(t, "assignment", assignment.formation, "leader %s spacing %g m%s slots %s"
+                                     % (assignment.leader, assignment.spacing, path, slots), NAN, NAN))
         if old is not None and old.formation != assignment.formation:
             self.run.events.append(Event(t, "switch", assignment.formation, old.formation, NAN, NAN))
 
