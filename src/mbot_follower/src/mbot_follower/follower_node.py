@@ -10,11 +10,12 @@ Every control period (sim time) it
    old data. Lookups and failures are counted and published;
 3. picks its target: its slot from ``/fleet/assignment`` (for a formation along the path, a
    column, the point of the leader's path its slot's distance behind the leader, from the
-   leader's map positions recorded since the assignment: trail.path_slot), or, when the slot or the straight way
-   to it is blocked (a wall, its inflation, something the laser sees), a point on the leader's
-   recent path (the trail) ``~trail_lookahead`` ahead of where the follower is on it, but no
-   nearer the leader than the slot is: a path the leader drove is free, also around corners and
-   through doors, and the follower rejoins its slot once the way is clear again;
+   leader's map positions recorded since the assignment: trail.path_slot), or, when the slot
+   or the straight way to it is blocked (a wall, its inflation, something the laser sees), a
+   point on the leader's recent path (the trail) ``~trail_lookahead`` ahead of where the
+   follower is on it, but no nearer the leader than the slot is: a path the leader drove is
+   free, also around corners and through doors, and the follower rejoins its slot once the way
+   is clear again;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
