@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -741,6 +742,40 @@ TEST(Faults, LatencyDelaysSamplesButKeepsTheirStamps)
   ASSERT_EQ(rec.truth[id].size(), 50u);
   for (size_t i = 0; i < rec.truth[id].size(); ++i)
     EXPECT_NEAR(rec.truth_release_times[i], rec.truth[id][i].stamp, 1e-9);
+}
+
+TEST(Faults, JitterAddsARandomDelayButKeepsTheOrder)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  rec.world = &world;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  const double latency = 0.1, jitter = 0.02;  // [s]; jitter = the extra delay's standard deviation
+  FaultConfig f;
+  f.sensor_latency = latency;
+  f.sensor_jitter = jitter;
+  world.setFaults("robot_0", f);
+  run(world, 20.0);
+  const std::vector<OdometrySample>& odom = rec.odom[id];
+  ASSERT_GT(odom.size(), 900u);  // 1000 measured at 50 Hz, the last few still on their way
+  double sum = 0.0, largest = 0.0;
+  for (size_t i = 0; i < odom.size(); ++i)
+  {
+    const double extra = rec.odom_release_times[i] - odom[i].stamp - latency;
+    EXPECT_GE(extra, -1e-9) << "sample " << i << " came before its latency";
+    if (i > 0) EXPECT_GT(odom[i].stamp, odom[i - 1].stamp) << "sample " << i << " overtook the one before";
+    sum += extra;
+    largest = std::max(largest, extra);
+  }
+  // Each sample waits |N(0, jitter)| more, or longer when the sample before it is still held
+  // (the order is kept): at least the half-normal mean jitter * sqrt(2 / pi) on average.
+  const double mean = sum / odom.size();
+  EXPECT_GT(mean, jitter * std::sqrt(2.0 / M_PI) * 0.9);
+  EXPECT_LT(mean, 3.0 * jitter);
+  EXPECT_LT(largest, 5.0 * jitter);
+  // A delayed sample physically stays what it measured: the stamp is when it was measured.
+  EXPECT_NEAR(odom.front().stamp, 0.02, 1e-9);
 }
 
 TEST(Faults, ResetDropsSamplesStillHeldBackByLatency)
