@@ -662,6 +662,79 @@ TEST(Noise, LaserNoiseHasTheConfiguredSpread)
   EXPECT_NEAR(sd, 0.05, 0.015);
 }
 
+namespace
+{
+/// Standard deviation of `values` (0 for fewer than 2).
+double spread(const std::vector<double>& values)
+{
+  if (values.size() < 2) return 0.0;
+  double mean = 0.0, sum2 = 0.0;
+  for (double v : values) mean += v / values.size();
+  for (double v : values) sum2 += (v - mean) * (v - mean);
+  return std::sqrt(sum2 / values.size());
+}
+}  // namespace
+
+// Live tuning (stage_node's dynamic_reconfigure server): new noise is in force from the next step.
+TEST(Noise, SetNoiseChangesTheSpreadFromTheNextStep)
+{
+  World world(roomMap(), WorldSettings{});  // no noise
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int still = world.addRobot("robot_0", model, Pose2D{2.0, 4.0, 0.0});
+  const int mover = world.addRobot("robot_1", model, Pose2D{2.0, 2.0, 0.0});
+  const size_t beam = beamAt(model, kPi);
+  // Beam kPi of the standing robot, and the measured speed of the one driving at 0.2 m/s (after
+  // its ramp), from sample `first` on.
+  const auto beamRanges = [&](size_t first) {
+    std::vector<double> v;
+    for (size_t i = first; i < rec.scans[still].size(); ++i) v.push_back(rec.scans[still][i].ranges[beam]);
+    return v;
+  };
+  const auto speeds = [&](size_t first) {
+    std::vector<double> v;
+    for (size_t i = first; i < rec.odom[mover].size(); ++i) v.push_back(rec.odom[mover][i].twist.vx);
+    return v;
+  };
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 1.0);  // up to speed
+  size_t scans0 = rec.scans[still].size(), odom0 = rec.odom[mover].size();
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 3.0);
+  ASSERT_GE(beamRanges(scans0).size(), 20u);
+  EXPECT_LT(spread(beamRanges(scans0)), 1e-6) << "no laser noise yet";
+  EXPECT_LT(spread(speeds(odom0)), 1e-3) << "no odometry noise yet";
+
+  world.setNoise(NoiseConfig{0.05, 0.03, 0.0});
+  EXPECT_EQ(world.noise().laser_range, 0.05);
+  EXPECT_EQ(world.noise().odom_linear, 0.03);
+  scans0 = rec.scans[still].size();
+  odom0 = rec.odom[mover].size();
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 3.0);
+  ASSERT_GE(beamRanges(scans0).size(), 20u);
+  EXPECT_NEAR(spread(beamRanges(scans0)), 0.05, 0.02) << "laser noise from the next scan on";
+  EXPECT_NEAR(spread(speeds(odom0)), 0.03, 0.012) << "odometry noise from the next step on";
+
+  // A bad value is refused with its name, and the noise in force stays.
+  std::string error;
+  try
+  {
+    world.setNoise(NoiseConfig{0.01, -0.1, 0.0});
+  }
+  catch (const SimError& e)
+  {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("noise.odom_linear"), std::string::npos) << error;
+  EXPECT_THROW(world.setNoise(NoiseConfig{std::nan(""), 0.0, 0.0}), SimError);
+  EXPECT_EQ(world.noise().laser_range, 0.05);
+  EXPECT_EQ(world.noise().odom_linear, 0.03);
+
+  world.setNoise(NoiseConfig{});  // and back to none
+  scans0 = rec.scans[still].size();
+  run(world, 2.0);
+  EXPECT_LT(spread(beamRanges(scans0)), 1e-6);
+}
+
 // ---- faults -----------------------------------------------------------------------------------
 
 TEST(Faults, LaserDropoutFractionMatchesTheProbability)
