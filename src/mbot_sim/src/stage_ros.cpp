@@ -12,6 +12,7 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -154,6 +155,7 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
       "real-time factor %g%s, seed %u",
       path.c_str(), world_->robotCount(), world_->obstacles().size(), world_->wallBoxCount(), world_->physicsStep(),
       real_time_factor_, real_time_factor_ == 0.0 ? " (as fast as possible)" : "", config.seed);
+  startReconfigureServer();
   if (params_.lockstep)
     ROS_INFO(
         "stage_node: lockstep: sim time waits for the driven robots' cmd_vel and localization every %g s "
@@ -296,6 +298,70 @@ void StageRos::publishMarkers()
     array.markers.push_back(m);
   }
   marker_pub_.publish(array);
+}
+
+// =============================================================================================
+// live tuning
+
+void StageRos::startReconfigureServer()
+{
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<SimulatorConfig>>(reconfigure_mutex_, ros::NodeHandle("~"));
+  SimulatorConfig c;
+  c.real_time_factor = real_time_factor_;
+  c.laser_range = world_->noise().laser_range;
+  c.odom_linear = world_->noise().odom_linear;
+  c.odom_angular = world_->noise().odom_angular;
+  // A value in force above the .cfg's maximum (the world file allows any) widens the maximum:
+  // the server then shows it as it is and never clamps it when another setting changes.
+  SimulatorConfig max = SimulatorConfig::__getMax__();
+  max.real_time_factor = std::max(max.real_time_factor, c.real_time_factor);
+  max.laser_range = std::max(max.laser_range, c.laser_range);
+  max.odom_linear = std::max(max.odom_linear, c.odom_linear);
+  max.odom_angular = std::max(max.odom_angular, c.odom_angular);
+  reconfigure_server_->setConfigMax(max);
+  reconfigure_server_->updateConfig(c);
+  // setCallback() calls onReconfigure() at once with these values: it finds nothing to change.
+  reconfigure_server_->setCallback([this](SimulatorConfig& config, uint32_t) { onReconfigure(config); });
+}
+
+/// In force from the next step. A refused value is written back to `c` as the value in force, so
+/// the server reports what runs.
+void StageRos::onReconfigure(SimulatorConfig& c)
+{
+  if (c.real_time_factor != real_time_factor_)
+  {
+    if (c.real_time_factor >= 0.0)  // NaN is not
+    {
+      real_time_factor_ = c.real_time_factor;
+      pacing_reset_ = true;  // pace from the current sim time on: sim time neither jumps nor catches up
+      ROS_INFO("stage_node: real-time factor %g%s from sim time %.3f s", real_time_factor_,
+               real_time_factor_ == 0.0 ? " (as fast as possible)" : "", world_->time());
+    }
+    else
+    {
+      ROS_ERROR("stage_node: real_time_factor: expected a number >= 0 (0 = as fast as possible), got %g; it stays %g",
+                c.real_time_factor, real_time_factor_);
+      c.real_time_factor = real_time_factor_;
+    }
+  }
+  const NoiseConfig& now = world_->noise();
+  if (c.laser_range != now.laser_range || c.odom_linear != now.odom_linear || c.odom_angular != now.odom_angular)
+  {
+    try
+    {
+      world_->setNoise(NoiseConfig{c.laser_range, c.odom_linear, c.odom_angular});
+      ROS_INFO("stage_node: noise: laser_range %g m, odom_linear %g m/s, odom_angular %g rad/s from sim time %.3f s",
+               c.laser_range, c.odom_linear, c.odom_angular, world_->time());
+    }
+    catch (const SimError& e)
+    {
+      ROS_ERROR("stage_node: %s; the noise stays", e.what());
+    }
+    c.laser_range = world_->noise().laser_range;
+    c.odom_linear = world_->noise().odom_linear;
+    c.odom_angular = world_->noise().odom_angular;
+  }
 }
 
 // =============================================================================================

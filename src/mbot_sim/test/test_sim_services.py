@@ -226,15 +226,46 @@ class SimServices(unittest.TestCase):
         self.assertAlmostEqual(largest_gap(self.truth["robot_0"]), 0.02, delta=1e-6)  # ground truth goes on
 
         self.assertTrue(self.set_fault(fault("robot_0", sensor_latency=0.5)).success)
-        t1 = rospy.get_time() + 0.2
-        self.odom["robot_0"].first_stamped_after(t1 + 1.0)
-        # receive time (this process's sim clock) - measurement stamp: 0.5 s, less by how much
-        # this process's clock lags the simulator's (well under 0.1 s), more by transport delays
-        delays = sorted(rt - m.header.stamp.to_sec() for (rt, m) in self.odom["robot_0"].received_since(0.0)
-                        if m.header.stamp.to_sec() > t1)
-        self.assertGreater(len(delays), 40)
-        self.assertGreater(delays[len(delays) // 2], 0.4)  # median
-        self.assertTrue(self.set_fault(fault("robot_0")).success)
+        try:
+            self.odom["robot_0"].first_stamped_after(rospy.get_time() + 1.0)
+            period, truth_period = (self.period(rec) for rec in (self.odom["robot_0"], self.truth["robot_0"]))
+            # Paused, no sample is released any more: the newest odometry that arrives is the last
+            # one measured at least 0.5 s before the pause (within one odometry period), the newest
+            # ground truth (never delayed) the last one measured before it (within its period).
+            # Both stamps come from the simulator, no receive times: a slow test process cannot
+            # shrink or stretch the measured delay.
+            self.pause()
+            try:
+                self.wait_for_quiet([self.odom["robot_0"], self.truth["robot_0"]])
+                lag = self.truth["robot_0"].latest().header.stamp.to_sec() - \
+                    self.odom["robot_0"].latest().header.stamp.to_sec()
+            finally:
+                self.unpause()
+            rospy.loginfo("latency 0.5 s: odometry %.3f s behind the ground truth at a pause", lag)
+            self.assertGreater(lag, 0.5 - truth_period - 1e-6, "ground truth period %.3f s" % truth_period)
+            self.assertLess(lag, 0.5 + period + 1e-6, "odometry period %.3f s" % period)
+        finally:
+            self.assertTrue(self.set_fault(fault("robot_0")).success)
+
+    @staticmethod
+    def period(recorder):
+        """The median time between the stamps of a recorder's last second of messages [s]."""
+        stamps = [m.header.stamp.to_sec() for m in recorder.stamped_after(rospy.get_time() - 1.0)]
+        return sorted(b - a for a, b in zip(stamps, stamps[1:]))[len(stamps) // 2]
+
+    @staticmethod
+    def wait_for_quiet(recorders, quiet=0.5, timeout=10.0):
+        """Wait (wall time) until none of the recorders got a message for `quiet` seconds."""
+        counts, since = None, time.time()
+        deadline = since + timeout
+        while time.time() < deadline:
+            now_counts = [len(r.messages) for r in recorders]
+            if now_counts != counts:
+                counts, since = now_counts, time.time()
+            elif time.time() - since >= quiet:
+                return
+            time.sleep(0.05)
+        raise AssertionError("messages still arriving %.0f s after the pause" % timeout)
 
     # ---- pause, reset -------------------------------------------------------------------------
     def test_pause_stops_sim_time(self):

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -661,6 +662,79 @@ TEST(Noise, LaserNoiseHasTheConfiguredSpread)
   EXPECT_NEAR(sd, 0.05, 0.015);
 }
 
+namespace
+{
+/// Standard deviation of `values` (0 for fewer than 2).
+double spread(const std::vector<double>& values)
+{
+  if (values.size() < 2) return 0.0;
+  double mean = 0.0, sum2 = 0.0;
+  for (double v : values) mean += v / values.size();
+  for (double v : values) sum2 += (v - mean) * (v - mean);
+  return std::sqrt(sum2 / values.size());
+}
+}  // namespace
+
+// Live tuning (stage_node's dynamic_reconfigure server): new noise is in force from the next step.
+TEST(Noise, SetNoiseChangesTheSpreadFromTheNextStep)
+{
+  World world(roomMap(), WorldSettings{});  // no noise
+  Recorder rec;
+  world.setListener(&rec);
+  const RobotModel model = diffModel();
+  const int still = world.addRobot("robot_0", model, Pose2D{2.0, 4.0, 0.0});
+  const int mover = world.addRobot("robot_1", model, Pose2D{2.0, 2.0, 0.0});
+  const size_t beam = beamAt(model, kPi);
+  // Beam kPi of the standing robot, and the measured speed of the one driving at 0.2 m/s (after
+  // its ramp), from sample `first` on.
+  const auto beamRanges = [&](size_t first) {
+    std::vector<double> v;
+    for (size_t i = first; i < rec.scans[still].size(); ++i) v.push_back(rec.scans[still][i].ranges[beam]);
+    return v;
+  };
+  const auto speeds = [&](size_t first) {
+    std::vector<double> v;
+    for (size_t i = first; i < rec.odom[mover].size(); ++i) v.push_back(rec.odom[mover][i].twist.vx);
+    return v;
+  };
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 1.0);  // up to speed
+  size_t scans0 = rec.scans[still].size(), odom0 = rec.odom[mover].size();
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 3.0);
+  ASSERT_GE(beamRanges(scans0).size(), 20u);
+  EXPECT_LT(spread(beamRanges(scans0)), 1e-6) << "no laser noise yet";
+  EXPECT_LT(spread(speeds(odom0)), 1e-3) << "no odometry noise yet";
+
+  world.setNoise(NoiseConfig{0.05, 0.03, 0.0});
+  EXPECT_EQ(world.noise().laser_range, 0.05);
+  EXPECT_EQ(world.noise().odom_linear, 0.03);
+  scans0 = rec.scans[still].size();
+  odom0 = rec.odom[mover].size();
+  drive(world, mover, Twist2D{0.2, 0.0, 0.0}, 3.0);
+  ASSERT_GE(beamRanges(scans0).size(), 20u);
+  EXPECT_NEAR(spread(beamRanges(scans0)), 0.05, 0.02) << "laser noise from the next scan on";
+  EXPECT_NEAR(spread(speeds(odom0)), 0.03, 0.012) << "odometry noise from the next step on";
+
+  // A bad value is refused with its name, and the noise in force stays.
+  std::string error;
+  try
+  {
+    world.setNoise(NoiseConfig{0.01, -0.1, 0.0});
+  }
+  catch (const SimError& e)
+  {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("noise.odom_linear"), std::string::npos) << error;
+  EXPECT_THROW(world.setNoise(NoiseConfig{std::nan(""), 0.0, 0.0}), SimError);
+  EXPECT_EQ(world.noise().laser_range, 0.05);
+  EXPECT_EQ(world.noise().odom_linear, 0.03);
+
+  world.setNoise(NoiseConfig{});  // and back to none
+  scans0 = rec.scans[still].size();
+  run(world, 2.0);
+  EXPECT_LT(spread(beamRanges(scans0)), 1e-6);
+}
+
 // ---- faults -----------------------------------------------------------------------------------
 
 TEST(Faults, LaserDropoutFractionMatchesTheProbability)
@@ -741,6 +815,40 @@ TEST(Faults, LatencyDelaysSamplesButKeepsTheirStamps)
   ASSERT_EQ(rec.truth[id].size(), 50u);
   for (size_t i = 0; i < rec.truth[id].size(); ++i)
     EXPECT_NEAR(rec.truth_release_times[i], rec.truth[id][i].stamp, 1e-9);
+}
+
+TEST(Faults, JitterAddsARandomDelayButKeepsTheOrder)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  rec.world = &world;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.0});
+  const double latency = 0.1, jitter = 0.02;  // [s]; jitter = the extra delay's standard deviation
+  FaultConfig f;
+  f.sensor_latency = latency;
+  f.sensor_jitter = jitter;
+  world.setFaults("robot_0", f);
+  run(world, 20.0);
+  const std::vector<OdometrySample>& odom = rec.odom[id];
+  ASSERT_GT(odom.size(), 900u);  // 1000 measured at 50 Hz, the last few still on their way
+  double sum = 0.0, largest = 0.0;
+  for (size_t i = 0; i < odom.size(); ++i)
+  {
+    const double extra = rec.odom_release_times[i] - odom[i].stamp - latency;
+    EXPECT_GE(extra, -1e-9) << "sample " << i << " came before its latency";
+    if (i > 0) EXPECT_GT(odom[i].stamp, odom[i - 1].stamp) << "sample " << i << " overtook the one before";
+    sum += extra;
+    largest = std::max(largest, extra);
+  }
+  // Each sample waits |N(0, jitter)| more, or longer when the sample before it is still held
+  // (the order is kept): at least the half-normal mean jitter * sqrt(2 / pi) on average.
+  const double mean = sum / odom.size();
+  EXPECT_GT(mean, jitter * std::sqrt(2.0 / M_PI) * 0.9);
+  EXPECT_LT(mean, 3.0 * jitter);
+  EXPECT_LT(largest, 5.0 * jitter);
+  // A delayed sample physically stays what it measured: the stamp is when it was measured.
+  EXPECT_NEAR(odom.front().stamp, 0.02, 1e-9);
 }
 
 TEST(Faults, ResetDropsSamplesStillHeldBackByLatency)

@@ -241,8 +241,18 @@ def mark_events(ax, run, t0, label=True):
             # Events at the same moment stack their labels instead of writing over each other.
             level = sum(1 for s in shown if abs(s - t) < 0.02 * max(1.0, ax.get_xlim()[1] - ax.get_xlim()[0]))
             shown.append(t)
-            ax.text(t, 0.88 - 0.12 * level, " " + m.label, transform=trans, color=color, fontsize=8, va="top",
-                    ha="left", zorder=6, bbox=dict(boxstyle="square,pad=0.1", fc="white", ec="none", alpha=0.75))
+            text, ha = _label_beside(ax, t, m.label)
+            ax.text(t, 0.88 - 0.12 * level, text, transform=trans, color=color, fontsize=8, va="top", ha=ha,
+                    zorder=6, bbox=dict(boxstyle="square,pad=0.1", fc="white", ec="none", alpha=0.75))
+
+
+def _label_beside(ax, t, text):
+    """(text, ha) for a label at x = t: right of the line, or left of it in the last quarter of
+    the axis, so that it does not run out of the plot into the legend."""
+    lo, hi = ax.get_xlim()
+    if t > lo + 0.75 * (hi - lo):
+        return text + " ", "right"
+    return " " + text, "left"
 
 
 def error_limit(values, threshold):
@@ -485,7 +495,8 @@ def plot_compare_errors(runs, labels, path, formation_limit):
         ax.axvline(t, color=color, ls=style, lw=1.2)
         level = sum(1 for s in shown if abs(s - t) < 0.08 * max(1.0, end - start))
         shown.append(t)
-        ax.text(t, 0.97 - 0.08 * level, " " + text, color=color, fontsize=8, va="top",
+        text, ha = _label_beside(ax, t, text)
+        ax.text(t, 0.97 - 0.08 * level, text, color=color, fontsize=8, va="top", ha=ha,
                 transform=ax.get_xaxis_transform(), bbox=dict(boxstyle="square,pad=0.1", fc="white", ec="none",
                                                               alpha=0.75))
     if formation_limit is not None:

@@ -437,3 +437,76 @@ int main(int argc, char** argv)
   testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }
+
+// ---------------------------------------------------------------------------------------------
+// The oscillation critic (dwa_local_planner's OscillationCostFunction): after a reversal on an
+// axis, only the new direction is allowed until the robot has moved or turned far enough.
+
+namespace
+{
+constexpr double kMinVelTrans = 0.1;  // [m/s] below this v_x the robot counts as "not driving"
+
+Trajectory chosen(double vx, double vy, double wz)
+{
+  Trajectory t;
+  t.velocity = Twist2D{vx, vy, wz};
+  t.cost = 1.0;  // a valid (chosen) trajectory
+  return t;
+}
+
+bool allowed(OscillationCritic& critic, double vx, double vy, double wz)
+{
+  return critic.score(chosen(vx, vy, wz)) >= 0.0;
+}
+}  // namespace
+
+TEST(OscillationCritic, TurningBackAndForthOnTheSpotIsStoppedUntilTheRobotTurnedFarEnough)
+{
+  OscillationCritic critic(0.05, 0.2);  // reset after 0.05 m or 0.2 rad
+  const Pose2D here{1.0, 2.0, 0.0};
+  critic.update(here, chosen(0.0, 0.0, 0.5), kMinVelTrans);   // turns left
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, -0.5));               // one turn is no oscillation yet
+  critic.update(here, chosen(0.0, 0.0, -0.5), kMinVelTrans);  // then right: a reversal
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, -0.5));
+  EXPECT_FALSE(allowed(critic, 0.0, 0.0, 0.5));  // turning left again is forbidden
+  critic.update(Pose2D{1.0, 2.0, -0.1}, chosen(0.0, 0.0, -0.5), kMinVelTrans);
+  EXPECT_FALSE(allowed(critic, 0.0, 0.0, 0.5));  // turned 0.1 rad: still restricted
+  critic.update(Pose2D{1.0, 2.0, -0.25}, chosen(0.0, 0.0, -0.5), kMinVelTrans);
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, 0.5));  // turned 0.25 rad > 0.2: free again
+}
+
+TEST(OscillationCritic, ForwardAndBackwardIsStoppedUntilTheRobotMovedFarEnough)
+{
+  OscillationCritic critic(0.05, 0.2);
+  critic.update(Pose2D{0.0, 0.0, 0.0}, chosen(0.2, 0.0, 0.0), kMinVelTrans);
+  critic.update(Pose2D{0.01, 0.0, 0.0}, chosen(-0.1, 0.0, 0.0), kMinVelTrans);  // backs up: a reversal
+  EXPECT_FALSE(allowed(critic, 0.2, 0.0, 0.0));
+  EXPECT_TRUE(allowed(critic, -0.1, 0.0, 0.0));
+  critic.update(Pose2D{-0.03, 0.0, 0.0}, chosen(-0.1, 0.0, 0.0), kMinVelTrans);
+  EXPECT_FALSE(allowed(critic, 0.2, 0.0, 0.0));  // 0.04 m from where it reversed
+  critic.update(Pose2D{-0.05, 0.0, 0.0}, chosen(-0.1, 0.0, 0.0), kMinVelTrans);
+  EXPECT_TRUE(allowed(critic, 0.2, 0.0, 0.0));  // 0.06 m > 0.05: free again
+}
+
+TEST(OscillationCritic, TurnsWhileDrivingAndRejectedTrajectoriesSetNoFlags)
+{
+  OscillationCritic critic(0.05, 0.2);
+  const Pose2D here{0.0, 0.0, 0.0};
+  // Weaving left and right while driving forward is steering, not oscillating.
+  critic.update(here, chosen(0.3, 0.0, 0.5), kMinVelTrans);
+  critic.update(here, chosen(0.3, 0.0, -0.5), kMinVelTrans);
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, 0.5));
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, -0.5));
+  // A cycle without a valid trajectory (cost < 0) is not a choice.
+  critic.update(here, chosen(0.0, 0.0, 0.5), kMinVelTrans);
+  Trajectory rejected = chosen(0.0, 0.0, -0.5);
+  rejected.cost = -1.0;
+  critic.update(here, rejected, kMinVelTrans);
+  EXPECT_TRUE(allowed(critic, 0.0, 0.0, 0.5));
+  // An omni robot strafing left, then right, on the spot.
+  critic.update(here, chosen(0.0, 0.1, 0.0), kMinVelTrans);
+  critic.update(here, chosen(0.0, -0.1, 0.0), kMinVelTrans);
+  EXPECT_FALSE(allowed(critic, 0.0, 0.1, 0.0));
+  critic.reset();  // a new plan clears every restriction
+  EXPECT_TRUE(allowed(critic, 0.0, 0.1, 0.0));
+}

@@ -2,12 +2,14 @@
  * @file stage_ros.h
  * @brief The ROS side of stage_node: reads the parameters once, builds the World from a world
  *        file, owns sim time (/clock, real-time factor, pause), converts sensor samples to
- *        messages and serves the run-time API. All simulation logic lives in World.
+ *        messages and serves the run-time API, with live tuning of the real-time factor and the
+ *        noise (dynamic_reconfigure, cfg/Simulator.cfg). All simulation logic lives in World.
  */
 #pragma once
 
 #include "mbot_sim/world.h"
 
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
@@ -17,6 +19,7 @@
 #include <mbot_msgs/SpawnObstacle.h>
 #include <mbot_msgs/SpawnRobot.h>
 #include <mbot_msgs/TeleportRobot.h>
+#include <mbot_sim/SimulatorConfig.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
@@ -25,6 +28,8 @@
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
+
+#include <boost/thread/recursive_mutex.hpp>
 
 #include <map>
 #include <memory>
@@ -129,6 +134,9 @@ private:
   bool onRemoveObstacle(mbot_msgs::RemoveObstacle::Request& req, mbot_msgs::RemoveObstacle::Response& res);
   bool onTeleport(mbot_msgs::TeleportRobot::Request& req, mbot_msgs::TeleportRobot::Response& res);
   bool onSetFault(mbot_msgs::SetFault::Request& req, mbot_msgs::SetFault::Response& res);
+  /// Live tuning (cfg/Simulator.cfg): start the server with the values in force.
+  void startReconfigureServer();
+  void onReconfigure(SimulatorConfig& config);
 
   ros::NodeHandle nh_;
   StageParams params_;
@@ -144,6 +152,10 @@ private:
   ros::Subscriber tf_sub_;         ///< lockstep only: the robots' localization transforms
   ros::Subscriber heartbeat_sub_;  ///< lockstep only: nodes that pace sim time (the fleet coordinator)
   std::vector<ros::ServiceServer> services_;
+  // dynamic_reconfigure at ~: its set_parameters service is served by run()'s callback queue, on
+  // the loop's thread between two steps, like every other service here; no step runs meanwhile.
+  boost::recursive_mutex reconfigure_mutex_;  ///< given to the server, so that updateConfig() is safe
+  std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_server_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
   double next_marker_time_ = 0.0;

@@ -184,6 +184,10 @@ public:
   /// @brief Replace all faults of a robot (a default FaultConfig clears them).
   /// @throws SimError: unknown robot, a value out of range
   void setFaults(const std::string& name, const FaultConfig& faults);
+  /// @brief Replace the sensor noise of every robot (live tuning); in force from the next step.
+  ///        Each robot keeps drawing from its own random stream.
+  /// @throws SimError: a value that is negative or not finite (the noise is then unchanged)
+  void setNoise(const NoiseConfig& noise);
   /// @brief Every robot back to its start pose at rest with its odometry at identity; moving
   ///        obstacles back to their first waypoint. Samples still held back by a latency fault
   ///        are dropped (they were measured before the reset). Sim time goes on.
@@ -209,6 +213,7 @@ public:
   Twist2D velocity(int robot) const;    ///< true velocity in the robot frame
   Pose2D odometry(int robot) const;     ///< current odometry pose (odom frame)
   const FaultConfig& faults(int robot) const;
+  const NoiseConfig& noise() const;  ///< the sensor noise in force
   /// @brief True when a circle of `radius` [m] at (x, y) inside the map overlaps no wall,
   ///        obstacle or robot.
   bool isFree(double x, double y, double radius) const;

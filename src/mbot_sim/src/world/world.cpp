@@ -433,6 +433,19 @@ struct World::Impl
     if (faults.drive_frozen) r.setpoint = Twist2D{};
   }
 
+  void setNoise(const NoiseConfig& noise)
+  {
+    const auto check = [](const char* field, double value, const char* unit) {
+      if (!(std::isfinite(value) && value >= 0.0))
+        throw SimError(std::string("noise.") + field + ": expected a standard deviation >= 0 " + unit + ", got " +
+                       std::to_string(value));
+    };
+    check("laser_range", noise.laser_range, "[m]");
+    check("odom_linear", noise.odom_linear, "[m/s]");
+    check("odom_angular", noise.odom_angular, "[rad/s]");
+    settings.noise = noise;
+  }
+
   void resetPositions()
   {
     for (auto& r : robots)
@@ -527,6 +540,7 @@ void World::addMovingObstacle(const MovingObstacleConfig& obstacle) { impl_->add
 void World::setCommand(int robot, const Twist2D& command) { impl_->setCommand(robot, command); }
 void World::teleport(const std::string& name, const Pose2D& pose) { impl_->teleport(name, pose); }
 void World::setFaults(const std::string& name, const FaultConfig& faults) { impl_->setFaults(name, faults); }
+void World::setNoise(const NoiseConfig& noise) { impl_->setNoise(noise); }
 void World::resetPositions() { impl_->resetPositions(); }
 void World::setListener(SensorListener* listener) { impl_->listener = listener; }
 void World::step() { impl_->step(); }
@@ -555,6 +569,7 @@ Pose2D World::groundTruth(int robot) const { return impl_->robotById(robot).pose
 Twist2D World::velocity(int robot) const { return impl_->robotById(robot).velocity; }
 Pose2D World::odometry(int robot) const { return impl_->robotById(robot).odom; }
 const FaultConfig& World::faults(int robot) const { return impl_->robotById(robot).faults; }
+const NoiseConfig& World::noise() const { return impl_->settings.noise; }
 
 bool World::isFree(double x, double y, double radius) const
 {
