@@ -16,10 +16,9 @@ While NAVIGATING, the leader waits (its goal is cancelled and sent again) whenev
 more than ``regroup_error`` off its slot, until all are within ``resume_error``: after a sharp
 turn, or a formation switch on the move, the slots move faster than a follower can drive, and a
 fleet that drives on while its shape is broken is not a formation (a column must stand before a
-corridor). Followers that follow the leader's trail past a wall are excused: the leader's waiting
-would not bring them closer. A follower that its safety layer holds is not: it gives way and
-gets free while the leader waits (a column must form before a corridor, not after it), and
-``regroup_timeout`` ends the wait if something holds it for good.
+corridor). Followers that follow the leader's trail past a wall, or that their safety layer holds
+(something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
+would not bring them closer.
 
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
 coordinator records the leader's path from the poses of every update(), started anew with each
@@ -193,7 +192,7 @@ class FleetCoordinator(object):
             "ABORTED: <why>"
         :param obstacle_ahead: something is close in front of the leader
         :param excused: followers off their slot for a reason the leader's waiting would not cure
-            (following the leader's trail past a wall)
+            (following the leader's trail past a wall, held by their safety layer)
         :returns: list of actions (module docstring)
         """
         actions = self._losses_and_rejoins(now, poses, last_heard)

@@ -270,7 +270,7 @@ class CoordinatorNode(object):
             obstacle = scan is not None and safety_stop(scan.ranges, scan.angle_min, scan.angle_increment,
                                                         self.params["pause_distance"], self.params["pause_half_angle"])
             # followers off their slot for a reason the leader's waiting would not cure
-            excused = [r for r, mode in self.controller_mode.items() if mode == "trail"]
+            excused = [r for r, mode in self.controller_mode.items() if mode in ("trail", "safety_stop")]
             nav = self._leader_nav()
             if nav != self._last_nav:
                 rospy.loginfo("coordinator: %s's navigation: %s", leader, nav or "no goal")
