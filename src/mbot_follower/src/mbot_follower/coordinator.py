@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from mbot_common.geometry import Pose2D, compose, normalize_angle
-from mbot_follower.assignment import assign_slots
+from mbot_follower.assignment import assign_single_file, assign_slots
 from mbot_follower.fleet_io import Assignment
 from mbot_follower.formations import FormationError, FormationLibrary
 from mbot_follower.shape import shape_errors
@@ -355,7 +355,9 @@ class FleetCoordinator(object):
         order = [self.leader] + [r for r in self.members if r != self.leader]
         slot_world = np.array([_apply(leader_pose, o) for o in formation.offsets])
         positions = np.array([[poses[r].x, poses[r].y] for r in order])
-        slot_of = assign_slots(positions, slot_world, leader_index=0)
+        single_file = formation.along_path and all(abs(o[1]) < 1e-9 for o in formation.offsets)
+        slot_of = assign_single_file(positions, slot_world, leader_pose.theta) if single_file \
+            else assign_slots(positions, slot_world, leader_index=0)
         robot_in_slot = {slot_of[i]: r for i, r in enumerate(order)}
         slots = {r: (float(formation.offsets[slot_of[i]][0]), float(formation.offsets[slot_of[i]][1]))
                  for i, r in enumerate(order)}
