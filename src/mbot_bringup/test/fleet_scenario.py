@@ -17,6 +17,7 @@ import unittest
 
 import rospy
 import rostest
+from mbot_common.paths import resolve_world
 from mbot_msgs.msg import Contact
 
 from mbot_bringup.goal_tour import load_goals
@@ -25,12 +26,6 @@ from mbot_bringup.recording import Recording
 from mbot_bringup.report import write_report
 
 GOAL_RADIUS = 0.3  # [m] the nav node's xy_goal_tolerance is smaller; this only catches a wrong place
-
-
-def world_file(world):
-    """maps/<world>.world.yaml of the workspace (this file is src/mbot_bringup/test/)."""
-    root = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
-    return os.path.join(root, "maps", world + ".world.yaml")
 
 
 class FleetScenario(unittest.TestCase):
@@ -74,7 +69,7 @@ class FleetScenario(unittest.TestCase):
         try:
             recording = os.path.join(out_dir, "recording.json")
             rec.save(recording)
-            with open(write_report(recording, world_file(world), out_dir)) as f:
+            with open(write_report(recording, resolve_world(world), out_dir)) as f:
                 page = f.read()
             self.assertEqual(page.count("<td>SUCCEEDED</td>"), sum(len(g) for g in goals.values()))
             self.assertTrue(os.path.getsize(os.path.join(out_dir, "trajectories.png")) > 0)

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "fixture_cases.h"
+#include "mbot_common/testing/fixture_cases.h"
 
 using mbot_common::loadMap;
 using mbot_common::MapError;

@@ -10,7 +10,7 @@
 
 #include <string>
 
-#include "fixture_cases.h"
+#include "mbot_common/testing/fixture_cases.h"
 
 using mbot_common::MovingObstacleConfig;
 using mbot_common::ShapeConfig;

@@ -7,7 +7,6 @@ wrong samples shows), then checks for every stamp t that tf map -> <robot>/odom 
 t + transform_tolerance equals T_map_base(gt, t) * inverse(T_odom_base(odom, t)) within 1e-6,
 and that amcl_pose is the ground truth.
 """
-import math
 import time
 import unittest
 
@@ -20,7 +19,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
-from mbot_common.geometry import quaternion_from_yaw, yaw_of
+from mbot_common.geometry import angle_diff, quaternion_from_yaw, yaw_of
 from mbot_common.waits import wait_for_wall as wait_for  # these tests publish /clock themselves
 
 PKG = "mbot_localization"
@@ -129,7 +128,7 @@ class FakeLocalizationTest(unittest.TestCase):
             self.assertAlmostEqual(msg.pose.pose.position.x, gx, places=9)
             self.assertAlmostEqual(msg.pose.pose.position.y, gy, places=9)
             o = msg.pose.pose.orientation
-            self.assertAlmostEqual(math.remainder(yaw_of(o) - gyaw, 2.0 * math.pi), 0.0, places=9)
+            self.assertAlmostEqual(angle_diff(yaw_of(o), gyaw), 0.0, places=9)
 
 
 if __name__ == "__main__":

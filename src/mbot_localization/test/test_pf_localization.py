@@ -24,7 +24,7 @@ from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from mbot_common.geometry import quaternion_from_yaw, yaw_of
+from mbot_common.geometry import angle_diff, normalize_angle, quaternion_from_yaw, yaw_of
 from mbot_common.waits import wait_for_wall as wait_for  # these tests publish /clock themselves
 
 PKG = "mbot_localization"
@@ -74,7 +74,7 @@ def compose(a, b):
     """Planar pose a * b."""
     c, s = math.cos(a[2]), math.sin(a[2])
     return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1],
-            math.remainder(a[2] + b[2], 2.0 * math.pi))
+            normalize_angle(a[2] + b[2]))
 
 
 def set_yaw(q, yaw):
@@ -160,7 +160,7 @@ class PfLocalizationTest(unittest.TestCase):
         if math.hypot(dx, dy) < 0.15:
             self.waypoint += 1
             return (0.0, 0.0, 0.0)
-        error = math.remainder(math.atan2(dy, dx) - self.truth[2], 2.0 * math.pi)
+        error = angle_diff(math.atan2(dy, dx), self.truth[2])
         return (0.05 if abs(error) < 0.3 else 0.005, 0.0, max(-0.15, min(0.15, error)))
 
     def step(self):
@@ -214,7 +214,7 @@ class PfLocalizationTest(unittest.TestCase):
         truth = self.truth_at[msg.header.stamp]
         p = msg.pose.pose
         return (math.hypot(p.position.x - truth[0], p.position.y - truth[1]),
-                abs(math.remainder(yaw_of(p.orientation) - truth[2], 2.0 * math.pi)))
+                abs(angle_diff(yaw_of(p.orientation), truth[2])))
 
     def drive_and_check(self, steps, label):
         count = len(self.poses)

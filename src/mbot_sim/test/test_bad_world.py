@@ -10,20 +10,26 @@ import roslib.packages
 import rospy
 import rostest
 
+# The simulator's own cases (models, robots against walls and each other) are here; the reader's
+# are mbot_common's fixtures.
 FIXTURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures")
+COMMON = os.path.join(roslib.packages.get_pkg_dir("mbot_common"), "test", "fixtures", "worlds")
 
 CASES = [
     # (world parameter, expected part of the message)
-    ("invalid_pose_type.world.yaml", 'invalid_pose_type.world.yaml: robots[1].pose: expected a list of 3 numbers '
-                                     '[x, y, yaw], got "1.0"'),
-    ("invalid_unknown_key.world.yaml", "invalid_unknown_key.world.yaml: gravity: unknown key"),
-    ("invalid_robot_in_wall.world.yaml", "robots[0].pose: robot robot_0 at (7.20, 1.00) overlaps a wall"),
-    ("invalid_robot_overlap.world.yaml", "robots[1].pose: robot robot_1 at (2.20, 2.00) overlaps robot robot_0"),
-    ("invalid_duplicate_robot.world.yaml", 'robots[1].name: duplicate name "robot_0"'),
-    ("invalid_missing_map.world.yaml", "invalid_missing_map.world.yaml: map: "),
-    ("invalid_bad_map.world.yaml", "invalid_header.pgm: bad PGM header"),
-    ("invalid_model.world.yaml", 'robots[0].model: cannot load model "hovercraft"'),
-    ("invalid_fault_probability.world.yaml", "faults[0].laser_dropout: expected a probability in [0, 1], got 1.5"),
+    (os.path.join(COMMON, "invalid_pose_type.world.yaml"),
+     'invalid_pose_type.world.yaml: robots[1].pose: expected a list of 3 numbers [x, y, yaw], got "1.0"'),
+    (os.path.join(COMMON, "invalid_unknown_key.world.yaml"), "invalid_unknown_key.world.yaml: gravity: unknown key"),
+    (os.path.join(FIXTURES, "invalid_robot_in_wall.world.yaml"),
+     "robots[0].pose: robot robot_0 at (7.20, 1.00) overlaps a wall"),
+    (os.path.join(FIXTURES, "invalid_robot_overlap.world.yaml"),
+     "robots[1].pose: robot robot_1 at (2.20, 2.00) overlaps robot robot_0"),
+    (os.path.join(COMMON, "invalid_duplicate_robot.world.yaml"), 'robots[1].name: duplicate name "robot_0"'),
+    (os.path.join(COMMON, "invalid_missing_map.world.yaml"), "invalid_missing_map.world.yaml: map: "),
+    (os.path.join(COMMON, "invalid_bad_map.world.yaml"), "invalid_header.pgm: bad PGM header"),
+    (os.path.join(FIXTURES, "invalid_model.world.yaml"), 'robots[0].model: cannot load model "hovercraft"'),
+    (os.path.join(COMMON, "invalid_fault_probability.world.yaml"),
+     "faults[0].laser_dropout: expected a probability in [0, 1], got 1.5"),
     ("no_such_world", 'world "no_such_world": no world file of that name'),
     ("/nonexistent/dir/some.world.yaml", "/nonexistent/dir/some.world.yaml: cannot read the file"),
 ]
@@ -41,8 +47,7 @@ class BadWorld(unittest.TestCase):
 
     def test_each_broken_world_gives_one_fatal_line_and_exit_code_1(self):
         for i, (world, expected) in enumerate(CASES):
-            path = os.path.join(FIXTURES, world) if world.endswith(".world.yaml") and "/" not in world else world
-            result = self.run_stage("__name:=bad_stage_%d" % i, "_world:=" + path)
+            result = self.run_stage("__name:=bad_stage_%d" % i, "_world:=" + world)
             self.assertEqual(result.returncode, 1, "%s: exit code %d, stderr:\n%s" % (world, result.returncode,
                                                                                       result.stderr))
             fatal = [line for line in result.stderr.splitlines() if "FATAL" in line]

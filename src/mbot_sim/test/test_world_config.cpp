@@ -1,11 +1,13 @@
 /**
  * @file test_world_config.cpp
  * @brief The strict world file reader: a file with every key reads into the right values, and
- *        each invalid_* fixture fails with a message naming the file, the key and the problem.
+ *        each invalid world fails with a message naming the file, the key and the problem: the
+ *        invalid_* fixtures of mbot_common (its reader's cases) and those here (buildWorld's).
  */
 #include "mbot_sim/world.h"
 
 #include <gtest/gtest.h>
+#include <mbot_common/testing/fixture_cases.h>
 
 #include <string>
 
@@ -17,6 +19,7 @@ using mbot_sim::WorldConfigError;
 namespace
 {
 const std::string kFixtures = MBOT_SIM_FIXTURES;
+const std::string kCommonWorlds = MBOT_COMMON_WORLD_FIXTURES;
 
 /// A circular robot model like mbot (the geometry tests do not need the URDF).
 mbot_description::RobotModel testModel(const std::string& name)
@@ -33,12 +36,12 @@ mbot_description::RobotModel testModel(const std::string& name)
   return m;
 }
 
-/// The message of reading and building `file`, or "" when it works.
-std::string worldError(const std::string& file)
+/// The message of reading and building the world file `path`, or "" when it works.
+std::string worldError(const std::string& path)
 {
   try
   {
-    const WorldConfig config = mbot_sim::loadWorldConfig(kFixtures + "/" + file);
+    const WorldConfig config = mbot_sim::loadWorldConfig(path);
     mbot_sim::buildWorld(config, &testModel);
   }
   catch (const WorldConfigError& e)
@@ -100,44 +103,38 @@ struct InvalidCase
 
 TEST(WorldConfig, EachInvalidFixtureGivesItsMessage)
 {
+  // What only buildWorld checks (models, robots against walls, obstacles, each other and the map).
   const InvalidCase cases[] = {
-      {"invalid_unknown_key.world.yaml", "gravity: unknown key (expected one of map, physics_step"},
-      {"invalid_robot_key.world.yaml", "robots[0].colour: unknown key (expected one of name, model, pose)"},
-      {"invalid_pose_type.world.yaml", "robots[1].pose: expected a list of 3 numbers [x, y, yaw], got \"1.0\""},
-      {"invalid_pose_length.world.yaml", "robots[0].pose: expected a list of 3 numbers [x, y, yaw], got a list of 2"},
-      {"invalid_no_map.world.yaml", "map: missing key (required)"},
-      {"invalid_missing_map.world.yaml", "map: " + kFixtures + "/no_such_map.yaml: cannot read the file"},
-      {"invalid_bad_map.world.yaml", "map: " + kFixtures + "/invalid_header.pgm: bad PGM header"},
-      {"invalid_duplicate_robot.world.yaml", "robots[1].name: duplicate name \"robot_0\""},
       {"invalid_robot_in_wall.world.yaml", "robots[0].pose: robot robot_0 at (7.20, 1.00) overlaps a wall"},
       {"invalid_robot_overlap.world.yaml", "robots[1].pose: robot robot_1 at (2.20, 2.00) overlaps robot robot_0"},
       {"invalid_robot_on_obstacle.world.yaml",
        "robots[0].pose: robot robot_0 at (2.30, 2.00) overlaps obstacle crate_1"},
       {"invalid_robot_outside.world.yaml", "robots[0].pose: robot robot_0 at (20.00, 2.00) is outside the map"},
       {"invalid_model.world.yaml", "robots[0].model: cannot load model \"hovercraft\": no model named hovercraft"},
-      {"invalid_speed.world.yaml", "moving_obstacles[0].speed: expected a number > 0 [m/s], got \"-0.5\""},
-      {"invalid_mode.world.yaml", "moving_obstacles[0].mode: expected loop or ping_pong, got \"bounce\""},
-      {"invalid_shape.world.yaml", "obstacles[0].shape: expected box or cylinder, got \"triangle\""},
-      {"invalid_box_radius.world.yaml", "obstacles[0].radius: a box has a size [length, width], not a radius"},
-      {"invalid_fault_probability.world.yaml", "faults[0].laser_dropout: expected a probability in [0, 1], got 1.5"},
-      {"invalid_fault_robot.world.yaml", "faults[0].robot: no robot named \"robot_9\" in robots"},
-      {"invalid_fault_bool.world.yaml", "faults[0].silenced: expected true or false, got \"1\""},
-      {"invalid_physics_step.world.yaml", "physics_step: expected a number > 0 [s], got \"fast\""},
-      {"invalid_seed.world.yaml", "seed: expected an integer >= 0, got \"1.5\""},
-      {"invalid_rtf.world.yaml", "real_time_factor: expected a number >= 0 (0 = as fast as possible), got \"-2\""},
-      {"invalid_name.world.yaml", "robots[0].name: expected a name of letters, digits and _"},
-      {"invalid_duplicate_key.world.yaml", "seed: duplicate key"},
-      {"invalid_syntax.world.yaml", "not valid YAML"},
-      {"invalid_robots_type.world.yaml", "robots: expected a list, got a map"},
-      {"invalid_noise.world.yaml", "noise.laser_range: expected a number >= 0 [m], got \"-0.01\""},
-      {"invalid_waypoints.world.yaml", "moving_obstacles[0].waypoints: expected a list of at least 2 points"},
   };
   for (const auto& c : cases)
   {
-    const std::string message = worldError(c.file);
-    const std::string expected = kFixtures + "/" + c.file + ": " + c.message;
+    const std::string path = kFixtures + "/" + c.file;
+    const std::string message = worldError(path);
+    const std::string expected = path + ": " + c.message;
     EXPECT_NE(message.find(expected), std::string::npos)
         << "fixture " << c.file << "\n  got:      " << message << "\n  expected: " << expected;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+  }
+}
+
+TEST(WorldConfig, EachCommonInvalidFixtureGivesItsMessageThroughTheSimulator)
+{
+  // mbot_common's invalid worlds, read and built as stage_node does: the simulator keeps the
+  // reader's message for each (the bad map, duplicate names, unknown keys, faults...).
+  const auto cases = mbot_common_test::invalidFixtures(kCommonWorlds, ".world.yaml");
+  EXPECT_GE(cases.size(), 40u) << "invalid_*.world.yaml in " << kCommonWorlds;
+  for (const auto& c : cases)
+  {
+    ASSERT_FALSE(c.expected.empty()) << c.path << ": no '# expect: ' first line";
+    const std::string message = worldError(c.path);
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "fixture " << c.path << "\n  got:      " << message << "\n  expected: " << c.expected;
     EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
   }
 }

@@ -5,6 +5,8 @@ navigation. Pure functions on plain lists, so it is testable without ROS.
 """
 import math
 
+from mbot_common.geometry import normalize_angle
+
 
 class WanderConfig(object):
     """Parameters of the wander behaviour."""
@@ -24,7 +26,7 @@ def side_clearance(ranges, angle_min, angle_increment, lo, hi, far=1e9):
     """Smallest finite range among beams whose angle is in [lo, hi] [rad]; +Inf beams count as far."""
     best = far
     for i, r in enumerate(ranges):
-        a = math.atan2(math.sin(angle_min + i * angle_increment), math.cos(angle_min + i * angle_increment))
+        a = normalize_angle(angle_min + i * angle_increment)
         if lo <= a <= hi:
             if r == float("-inf"):   # REP-117: too close to measure
                 return 0.0

@@ -1,5 +1,5 @@
 """The invalid_* fixtures of test/fixtures/{maps,worlds}: each begins with `# expect: <message>`
-({file} = the fixture's path, {dir} = its folder). The gtests (test/fixture_cases.h) read the
+({file} = the fixture's path, {dir} = its folder). The gtests (mbot_common/testing/fixture_cases.h) read the
 same lines, so the C++ and the Python reader must give the same message for each."""
 import os
 

@@ -21,7 +21,7 @@ from nav_msgs.srv import GetPlan, GetPlanRequest
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
-from mbot_common.geometry import yaw_of
+from mbot_common.geometry import normalize_angle, yaw_of
 from mbot_common.waits import wait_for_wall
 from nav_test_tools import Track, action_client, make_goal, state_name, wait_until
 
@@ -87,7 +87,7 @@ def phantom_scan(tf_buffer, x, y):
     scan = LaserScan()
     scan.header.frame_id = "%s/base_laser" % ROBOT
     scan.header.stamp = t.header.stamp
-    scan.angle_min = scan.angle_max = math.atan2(math.sin(bearing), math.cos(bearing))
+    scan.angle_min = scan.angle_max = normalize_angle(bearing)
     scan.angle_increment = 0.01
     scan.range_min, scan.range_max = 0.12, 8.0
     scan.ranges = [math.hypot(x - lx, y - ly)]

@@ -6,7 +6,7 @@ import threading
 
 import rospy
 from actionlib_msgs.msg import GoalStatus
-from mbot_common.geometry import yaw_of
+from mbot_common.geometry import angle_diff as signed_angle_diff, yaw_of
 from mbot_common.waits import wait_for_sim as wait_until  # noqa: F401 (the tests import it from here)
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import OccupancyGrid, Odometry
@@ -88,4 +88,5 @@ def wait_for_map(timeout=60.0):
 
 
 def angle_diff(a, b):
-    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))
+    """|a - b| the short way round [rad], in [0, pi]."""
+    return abs(signed_angle_diff(a, b))

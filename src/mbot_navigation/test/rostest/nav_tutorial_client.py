@@ -15,7 +15,7 @@ from actionlib_msgs.msg import GoalStatus, GoalStatusArray
 from geometry_msgs.msg import PoseStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
-from nav_test_tools import Track, wait_until
+from nav_test_tools import Track, angle_diff, wait_until
 
 
 def movebase_client():
@@ -70,7 +70,7 @@ class TutorialClient(unittest.TestCase):
         self.assertEqual(state, GoalStatus.SUCCEEDED, text)
         x, y, yaw = track.pose
         self.assertLess(math.hypot(x - 3.0, y - 4.0), 0.15, track.pose)
-        self.assertLess(abs(math.atan2(math.sin(yaw), math.cos(yaw))), 0.15, track.pose)
+        self.assertLess(angle_diff(yaw, 0.0), 0.15, track.pose)
 
     def test_2_move_base_simple_goal(self):
         track = Track("robot_1")
@@ -102,7 +102,7 @@ class TutorialClient(unittest.TestCase):
         wait_until(lambda: GoalStatus.SUCCEEDED in new().values(), 90.0, "SUCCEEDED on robot_1/move_base/status")
         x, y, yaw = track.pose
         self.assertLess(math.hypot(x - 3.0, y - 7.5), 0.15, track.pose)
-        self.assertLess(abs(math.atan2(math.sin(yaw - math.pi / 2), math.cos(yaw - math.pi / 2))), 0.15, track.pose)
+        self.assertLess(angle_diff(yaw, math.pi / 2), 0.15, track.pose)
 
 
 if __name__ == "__main__":

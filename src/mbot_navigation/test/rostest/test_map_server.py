@@ -17,6 +17,7 @@ import rospy
 import rostest
 import rospkg
 from mbot_common.maps import load_map
+from mbot_common.paths import find_maps_directory
 from nav_msgs.msg import MapMetaData, OccupancyGrid
 from nav_msgs.srv import GetMap
 from roslib.packages import find_node
@@ -69,9 +70,8 @@ class MapServerTest(unittest.TestCase):
                          FIXTURE_NEGATED)
 
     def test_bare_name_comes_from_workspace_maps(self):
-        # the workspace's maps/ folder is next to src/, which holds this package
-        package = os.path.realpath(rospkg.RosPack().get_path(PKG))
-        maps = os.path.join(os.path.dirname(os.path.dirname(package)), "maps")
+        # the workspace's maps/ folder, found from this package as map_server looks for it
+        maps = find_maps_directory(rospkg.RosPack().get_path(PKG))
         expected = load_map(os.path.join(maps, "empty.yaml"))
         grid = rospy.wait_for_message("/bare/map", OccupancyGrid, timeout=TIMEOUT)
         self.check_info(grid.info, expected.width, expected.height, expected.resolution, expected.origin)

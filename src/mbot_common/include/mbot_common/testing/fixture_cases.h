@@ -1,9 +1,10 @@
 /**
  * @file fixture_cases.h
- * @brief The invalid_* fixtures of test/fixtures/{maps,worlds}: each begins with
+ * @brief The invalid_* fixtures of mbot_common's test/fixtures/{maps,worlds}: each begins with
  *        `# expect: <message>` ({file} = the fixture's path, {dir} = its folder). The gtests and
  *        the pytest tests (test/unit/common_fixture_cases.py) read the same lines, so the C++ and the
- *        Python reader must give the same message for each.
+ *        Python reader must give the same message for each; mbot_sim's test_world_config runs the world
+ *        fixtures through the simulator too.
  */
 #pragma once
 
