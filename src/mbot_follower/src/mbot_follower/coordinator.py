@@ -20,6 +20,15 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
 would not bring them closer.
 
+Except right after a formation switch: then the followers change places, and on the way they
+block each other (the safety layer holds one, or another robot blocks its way to the slot and it
+takes the trail): those are the robots the leader waits for. A follower's mode flickers between
+slot, trail, safety_stop and give_way while robots pass each other, and an excused follower let
+the leader drive on every time it flickered (the corridor column formed past the entrance). So
+the first regroup after a switch waits for every follower, excused or not, until all are within
+``resume_error`` or ``regroup_timeout`` passes; held followers give way meanwhile (GiveWay), so
+they do not jam for good. The switch is over when its shape is stable or that regroup ended.
+
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
 coordinator records the leader's path from the poses of every update(), started anew with each
 assignment, and measures the followers against those slots and their headings, so a column
@@ -111,6 +120,7 @@ class FleetCoordinator(object):
         self._pause_until = None
         self._no_pause_before = -1e9
         self._switch_started = None
+        self._switch_waits = False           # after a switch: the leader waits for every follower
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
@@ -166,6 +176,7 @@ class FleetCoordinator(object):
         self.formation, self.spacing = name, spacing
         self.requested_formation = name
         self._switch_started = now
+        self._switch_waits = self.phase == NAVIGATING  # (FORMING waits for every follower anyway)
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
         # While navigating, the state stays NAVIGATING: when the robots changing places fall far
         # behind their new slots, the leader waits for them (regrouping, see update()).
@@ -192,7 +203,8 @@ class FleetCoordinator(object):
             "ABORTED: <why>"
         :param obstacle_ahead: something is close in front of the leader
         :param excused: followers off their slot for a reason the leader's waiting would not cure
-            (following the leader's trail past a wall, held by their safety layer)
+            (following the leader's trail past a wall, held by their safety layer); not after a
+            switch (module docstring)
         :returns: list of actions (module docstring)
         """
         actions = self._losses_and_rejoins(now, poses, last_heard)
@@ -206,6 +218,7 @@ class FleetCoordinator(object):
         if self._switch_started is not None and stable:
             self.events.append((now, "switched", "%s reached in %.1f s" % (self.formation, now - self._switch_started)))
             self._switch_started = None
+            self._switch_waits = False
 
         if self.phase == FORMING:
             timed_out = now - self._phase_since > self.config.forming_timeout
@@ -257,6 +270,8 @@ class FleetCoordinator(object):
         """The leader waits while a follower is far off its slot (after a sharp turn, or when a
         follower was held up) and drives on once all are close again. None: nothing to do;
         else the actions (possibly none) of waiting."""
+        if self._switch_waits:
+            excused = ()
         errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
         if self._regroup_since is None:
@@ -270,6 +285,7 @@ class FleetCoordinator(object):
         if worst is not None and worst[1] >= self.config.resume_error and not timed_out:
             return []
         self._regroup_since = None
+        self._switch_waits = False  # once: a follower that cannot reach its slot is excused again
         if timed_out:
             self._no_regroup_before = now + self.config.regroup_timeout
         self.reason = "regrouped: driving on" if not timed_out else \
@@ -432,6 +448,7 @@ class FleetCoordinator(object):
         self.phase = phase
         self._phase_since = now
         self._regroup_since = None
+        self._switch_waits = False
         self.reason = reason
 
 

@@ -15,7 +15,9 @@ Every control period (sim time) it
    point on the leader's recent path (the trail) ``~trail_lookahead`` ahead of where the
    follower is on it, but no nearer the leader than the slot is: a path the leader drove is
    free, also around corners and through doors, and the follower rejoins its slot once the way
-   is clear again;
+   is clear again. A path shorter than the slot's distance from the leader (it has just set
+   off) has no such point: the follower keeps to its slot (its safety layer stops it short of
+   what blocks it) rather than drive ahead of the robots that belong in front of it;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
@@ -303,10 +305,12 @@ class FollowerController(object):
                 me_map.x, me_map.y, slot_map.x, slot_map.y)
         if not blocked:
             blocked = self._scan_blocks(pose, slot)
-        if not blocked or len(self.trail) < 2:
+        point = None
+        if blocked and len(self.trail):
+            point = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
+        if point is None:  # not blocked, or the leader's path does not reach back to the slot yet
             return slot, "slot"
-        tx, ty = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
-        t = relative(ref_map, Pose2D(tx, ty, 0.0))
+        t = relative(ref_map, Pose2D(point[0], point[1], 0.0))
         return (t.x, t.y), "trail"
 
     def _scan_blocks(self, pose, slot):

@@ -110,12 +110,18 @@ class Trail(object):
         """(x, y) to drive to for a robot at (x, y) that follows the path: `lookahead` [m] of path
         beyond the path point nearest to the robot, but no nearer to the newest point than
         `distance` [m] of path. Driving straight to it stays near the path, around corners and
-        through doors, where the point `distance` behind the newest may lie behind a wall."""
+        through doors, where the point `distance` behind the newest may lie behind a wall.
+        None when the path is shorter than `distance` (the leader has just set off): every point
+        of it lies nearer to the leader than the robot's slot, and driving there would put the
+        robot ahead of the ones that belong in front of it (a column that cannot sort itself
+        out again)."""
         if not self._points:
             raise ValueError("Trail.pursuit_point: the trail is empty (add() the leader's positions first)")
         for name, value in (("lookahead", lookahead), ("distance", distance)):
             if isinstance(value, bool) or not math.isfinite(value) or value < 0:
                 raise ValueError("Trail.pursuit_point: %s must be a finite number >= 0 [m], got %r" % (name, value))
+        if self._length < distance:
+            return None
         nearest, at = float("inf"), 0.0     # distance to the path, arc length from the oldest point
         arc = 0.0
         for k, step in enumerate(self._steps):

@@ -296,6 +296,37 @@ def test_the_leader_left_alone_keeps_its_goal_and_the_others_rejoin():
     assert len(core.assignment.slots) == 3
 
 
+def test_after_a_switch_on_the_move_the_leader_waits_for_excused_followers_too():
+    # changing places, followers block each other: held or on the trail, they flicker in and
+    # out of being excused, and the leader must not drive on at each flicker
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    ok, _, _ = core.set_formation("line", t, poses)
+    assert ok
+    off = dict(poses)   # still on the triangle's slots, far from the line's
+    actions = core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1"])
+    assert actions == [("cancel", "leader")] and "regrouping" in core.reason
+    for i, excused in enumerate((["follower_1", "follower_2"], [], ["follower_2"])):
+        assert core.update(t + 0.2 + 0.1 * i, off, heard(t + 0.2 + 0.1 * i), excused=excused) == []
+    t += 1.0
+    actions = core.update(t, at_slots(core, poses["leader"]), heard(t), excused=["follower_1"])
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "regrouped" in core.reason
+
+
+def test_after_the_switch_regroup_ends_excused_followers_no_longer_hold_up_the_leader():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("line", t, poses)
+    off = dict(poses)
+    core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1", "follower_2"])
+    t += 0.1 + core.config.regroup_timeout + 0.1
+    actions = core.update(t, off, heard(t), excused=["follower_1", "follower_2"])
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "regrouping" in core.reason
+    # behind a wall for good: after the timeout's pause they are excused as before the switch
+    t += core.config.regroup_timeout + 0.1
+    assert core.update(t, off, heard(t), leader_nav="ACTIVE", excused=["follower_1", "follower_2"]) == []
+
+
 # --- a column along the leader's path --------------------------------------------------------
 
 def l_path(s):

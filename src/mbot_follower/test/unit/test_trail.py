@@ -204,3 +204,14 @@ def test_path_pose_refuses_bad_distance_and_trail():
         path_pose((0.0, 0.0, 0.0), [(0.0, 0.0)], 1.0)
     with pytest.raises(ValueError, match="Trail.start: x, y and heading"):
         trail.start(0.0, 0.0, float("nan"))
+
+
+def test_a_path_shorter_than_the_slot_distance_has_no_pursuit_point():
+    # the leader has just set off: every point of its path is nearer to it than a slot 2 m
+    # behind, and pursuing one would take the follower ahead of those in front of it
+    trail = Trail(min_step=0.05)
+    for x in (0.0, 0.5, 1.0, 1.5):
+        trail.add(x, 0.0)
+    assert trail.pursuit_point(-1.0, 0.5, 0.6, 2.0) is None
+    trail.add(2.0, 0.0)   # 2 m of path now
+    assert trail.pursuit_point(-1.0, 0.5, 0.6, 2.0) == pytest.approx((0.0, 0.0))
