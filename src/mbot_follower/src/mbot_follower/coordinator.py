@@ -20,7 +20,7 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
 would not bring them closer.
 
-Except right after a formation switch: then the followers change places, and on the way they
+Except right after a formation switch on the move: the followers change places, and on the way they
 block each other (the safety layer holds one, or another robot blocks its way to the slot and it
 takes the trail): those are the robots the leader waits for. A follower's mode flickers between
 slot, trail, safety_stop and give_way while robots pass each other, and an excused follower let
