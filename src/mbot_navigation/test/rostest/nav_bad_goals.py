@@ -99,8 +99,10 @@ class BadGoals(unittest.TestCase):
         self.client.send_goal(make_goal(-5.0, -5.0))
         self.client.cancel_goal()
         self.assertTrue(self.client.wait_for_result(rospy.Duration(5.0)), "the cancelled goal did not end")
-        self.assertIn(self.client.get_state(), (GoalStatus.PREEMPTED, GoalStatus.RECALLED),
-                      self.client.get_goal_status_text())
+        # LOST: the node's status came before it had the goal (the goal and the cancel travel on
+        # separate topics), and the client stops tracking it; whether the robot stays is what counts
+        self.assertIn(self.client.get_state(), (GoalStatus.PREEMPTED, GoalStatus.RECALLED, GoalStatus.LOST),
+                      "%s: %s" % (state_name(self.client.get_state()), self.client.get_goal_status_text()))
         rospy.sleep(2.0)   # [sim s] time enough to set off, had the goal been taken
         moved = math.hypot(self.track.pose[0] - start[0], self.track.pose[1] - start[1])
         self.assertLess(moved, 0.05, "the robot drove %.2f m after the cancel" % moved)
