@@ -83,8 +83,14 @@ class Trail(object):
             self._length -= self._steps.popleft()
             self._points.popleft()
             # the straight path behind the oldest point goes on where the kept path starts
-            (x0, y0), (x1, y1) = self._points[0], self._points[1]
-            self.tail_heading = math.atan2(y1 - y0, x1 - x0)
+            self.tail_heading = self._oldest_step_heading()
+
+    def _oldest_step_heading(self):
+        """Direction of the step from the oldest point to the next [rad]; None below 2 points."""
+        if len(self._points) < 2:
+            return None
+        (x0, y0), (x1, y1) = self._points[0], self._points[1]
+        return math.atan2(y1 - y0, x1 - x0)
 
     def point_behind(self, distance):
         """(x, y) at arc length `distance` [m] behind the newest point, walking back along the
@@ -151,26 +157,28 @@ def _pose_arg(function, name, value):
 def _tail_heading(head, trail):
     if trail.tail_heading is not None:
         return trail.tail_heading
-    if len(trail) >= 2:   # never started: the path goes on as its oldest step goes
-        (x0, y0), (x1, y1) = trail._points[0], trail._points[1]
-        return math.atan2(y1 - y0, x1 - x0)
-    return head.theta
+    heading = trail._oldest_step_heading()   # never started: the path goes on as its oldest step goes
+    return head.theta if heading is None else heading
 
 
 def _point_behind(head, trail, distance):
-    """(x, y) at arc length `distance` >= 0 behind the head, walking back from the head's position
-    through the trail's points, then straight on along the tail heading."""
-    left = distance
-    nx, ny = head.x, head.y
-    for px, py in reversed(trail._points):
-        step = math.hypot(nx - px, ny - py)
-        if left <= step and step > 0.0:
-            f = left / step
-            return nx + f * (px - nx), ny + f * (py - ny)
-        left -= step
-        nx, ny = px, py
+    """(x, y) at arc length `distance` >= 0 behind the head: from the head's position to the
+    trail's newest point, back along the trail (Trail.point_behind), then straight on along the
+    tail heading."""
+    if len(trail):
+        nx, ny = trail.point_behind(0.0)
+        to_newest = math.hypot(nx - head.x, ny - head.y)
+        if distance <= to_newest and to_newest > 0.0:
+            f = distance / to_newest
+            return head.x + f * (nx - head.x), head.y + f * (ny - head.y)
+        left = distance - to_newest
+        if left <= trail.length():
+            return trail.point_behind(left)
+        (ox, oy), left = trail.point_behind(trail.length()), left - trail.length()
+    else:
+        (ox, oy), left = (head.x, head.y), distance
     tail = _tail_heading(head, trail)
-    return nx - left * math.cos(tail), ny - left * math.sin(tail)
+    return ox - left * math.cos(tail), oy - left * math.sin(tail)
 
 
 def path_pose(head, trail, distance):
