@@ -28,7 +28,10 @@ What the numbers mean (all times sim time unless marked wall):
   steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED;
                     while navigating, a follower's sample counts once its slot has been free
                     for free_hold (the time to get back from the trail). slot_blocked_share
-                    says how much of the navigating time the slots were in walls.
+                    says how much of the navigating time the slots were in walls. A follower
+                    whose controller has gone silent for controller_silence (killed, before
+                    the coordinator declares it lost) does not count: that error is the loss
+                    detection time, measured by the recovery figures.
   leader lateral    distance of the leader from the polyline of its global plan (the newest one not
                     later than the leader's pose; a new goal, FORMING, forgets the old plans); the
                     summary counts it while the leader follows the plan (NAVIGATING, DEGRADED).
@@ -56,6 +59,7 @@ What the numbers mean (all times sim time unless marked wall):
 Offline: `/usr/bin/python3 -m mbot_follower.metrics OUTPUT_DIR` prints the summary of a run.
 """
 import argparse
+import bisect
 import csv
 import json
 import math
@@ -99,7 +103,7 @@ class MetricsConfig(object):
 
     def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
                  robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0,
-                 slot_clearance=0.25, free_hold=3.0):
+                 slot_clearance=0.25, free_hold=3.0, controller_silence=0.5):
         self.rate = rate                      # samples per sim second [Hz]
         self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
@@ -111,6 +115,7 @@ class MetricsConfig(object):
         self.hold_back = hold_back            # a sample waits this long for a late robot's poses [s]
         self.slot_clearance = slot_clearance  # a slot closer than this to a wall is not free [m]
         self.free_hold = free_hold            # a slot free this long counts in the steady RMS [s]
+        self.controller_silence = controller_silence  # a controller unheard this long is gone [s]
         self.check()
 
     def check(self):
@@ -118,7 +123,7 @@ class MetricsConfig(object):
         limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
                   ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True),
-                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True)]
+                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True), ("controller_silence", 0.0, False)]
         for key, low, low_ok in limits:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
@@ -505,6 +510,13 @@ def _leader_speed(before, now):
     return speed if math.isfinite(speed) else 0.0
 
 
+def _controller_silent(times, t, config):
+    """Whether a controller heard at the sorted times has been silent at t for controller_silence
+    (one never heard is not: it may not publish at all)."""
+    k = bisect.bisect_right(times, t + 1e-9)
+    return k > 0 and t - times[k - 1] >= config.controller_silence
+
+
 def summarize(run):
     """The summary of a Run: a JSON-ready dict (units in the key names, None = no data)."""
     config = run.config
@@ -529,7 +541,9 @@ def summarize(run):
         robots[r] = entry
 
     # Steady errors: ARRIVED, and NAVIGATING while the leader moves (its speed from this sample
-    # and the one before) for the followers whose slots have been free for free_hold.
+    # and the one before) for the followers whose slots have been free for free_hold and whose
+    # controllers are alive.
+    heard = {r: sorted(c.t for c in cs) for r, cs in controller.items()}
     navigating, arrived = [], []
     blocked_since = {}   # robot -> time of its slot's newest blocked sample
     moving_samples = blocked_samples = 0
@@ -537,13 +551,12 @@ def summarize(run):
         for r, rs in s.robots.items():
             if rs.slot_free == 0.0:
                 blocked_since[r] = s.t
-        followers = [rs.slot_error for rs in s.robots.values()]
+        followers = {r: rs for r, rs in s.robots.items()
+                     if math.isfinite(rs.slot_error) and not _controller_silent(heard.get(r, ()), s.t, config)}
         if s.state == "ARRIVED":
-            arrived += followers
+            arrived += [rs.slot_error for rs in followers.values()]
         elif s.state == "NAVIGATING" and i > 0 and _leader_speed(run.samples[i - 1], s) > config.moving_speed:
-            for r, rs in s.robots.items():
-                if not math.isfinite(rs.slot_error):
-                    continue
+            for r, rs in followers.items():
                 moving_samples += 1
                 if s.t - blocked_since.get(r, -math.inf) >= config.free_hold - 1e-9:
                     navigating.append(rs.slot_error)

@@ -287,6 +287,36 @@ def test_steady_rms_in_navigating_while_moving_and_in_arrived():
                                     "ARRIVED": pytest.approx(1.9)}
 
 
+def test_a_follower_whose_controller_fell_silent_leaves_the_steady_rms():
+    """robot_2's controller stops at 4 s (killed) and the robot stands while the leader drives on:
+    its growing error is the time the coordinator takes to declare it lost, not the formation's
+    steady error. It counts until its controller has been silent for controller_silence."""
+    c = MetricsCollector(MetricsConfig(controller_silence=0.5))
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0), "robot_2": (-2.0, 0.0)},
+                               "column"))
+
+    def at(t):
+        if near(t, 0.0):
+            c.on_status(t, "NAVIGATING", "", [])
+        for r in ("robot_1", "robot_2"):
+            if r == "robot_1" or t < 4.0 - 1e-9:
+                c.on_follower_state(r, t, t, True, 1, 0, 0.001, "track")
+
+    def poses(t):
+        lx = 0.5 * t
+        return {"robot_0": (lx, 0.0, 0.0), "robot_1": (lx - 1.0, 0.1, 0.0),
+                "robot_2": (min(lx, 2.0) - 2.0, 0.1, 0.0)}   # stands from 4 s on
+
+    drive(c, 0.0, 8.0, poses, at)
+    s = summarize(c.run)["fleet"]
+    # robot_2 counts until its controller has been silent 0.5 s: off by at most ~0.2 m then,
+    # while it ends 2 m from its slot.
+    assert s["slot_max_m"] > 1.9
+    assert s["steady_navigating_slot_rms_m"] < 0.13
+    c.run.config = MetricsConfig(controller_silence=100.0)   # never silent: all of its error counts
+    assert summarize(c.run)["fleet"]["steady_navigating_slot_rms_m"] > 0.5
+
+
 def test_clearance_contacts_and_stale_poses():
     c = MetricsCollector(MetricsConfig(robot_radius=0.15))
     c.on_pose("robot_3", 0.0, 0.0, 0.6, 0.0)   # heard once: stale after 1 s, then never counted
