@@ -191,12 +191,13 @@ def target_time(run):
     return run.samples[0].t if run.samples else 0.0
 
 
-def arrival_time(run):
-    """Sim time [s] of the first ARRIVED, or None."""
-    for e in sorted_events(run):
-        if e.kind == "state" and e.name == "ARRIVED":
-            return e.t
-    return None
+def arrival_time(run, last=False):
+    """Sim time [s] of the first ARRIVED (last: of the last one, the end of a route of several
+    targets), or None."""
+    times = [e.t for e in sorted_events(run) if e.kind == "state" and e.name == "ARRIVED"]
+    if not times:
+        return None
+    return times[-1] if last else times[0]
 
 
 def state_spans(run, end):

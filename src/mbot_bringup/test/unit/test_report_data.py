@@ -6,11 +6,11 @@ import os
 import numpy as np
 import pytest
 
-from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, assignment_at, assignments, \
+from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, arrival_time, assignment_at, assignments, \
     compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, speeds, \
     switch_settling
 from mbot_bringup.colors import robot_colors
-from mbot_bringup.report_plots import error_limit, snapshot_indices
+from mbot_bringup.report_plots import error_limit, snapshot_indices, snapshot_labels
 from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize
 
 FIXTURE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "run_trio")
@@ -157,6 +157,26 @@ def test_snapshots_fall_where_the_fleet_moves():
     assert any(0.0 <= t - 19.0 < 0.2 for t in times)               # the switch (the first sample after it)
     assert any(19.5 < t < 25.0 for t in times)                     # the followers moving out while the leader waits
     assert 8 <= len(chosen) <= 13
+
+
+def test_snapshots_reach_the_last_arrival_of_a_route_of_several_targets():
+    """Two targets: ARRIVED at 10 s, then the fleet drives on and arrives again at 30 s; the
+    snapshots cover the second leg too, none within a second of another."""
+    run = load_run(os.path.join(FIXTURE, "metrics"))
+    first = arrival_time(run)
+    run.events.append(Event(first - 30.0, "state", "ARRIVED", "an earlier target", NAN, NAN))
+    series = Series(run)
+    times = [series.t[i] for i in snapshot_indices(series, run)]
+    assert arrival_time(run) == pytest.approx(first - 30.0)
+    assert arrival_time(run, last=True) == pytest.approx(first)
+    assert times[-1] == pytest.approx(51.75)
+    assert min(b - a for a, b in zip(times, times[1:])) >= 1.0 - 1e-9
+
+
+def test_snapshots_at_one_place_share_one_time_label():
+    labels = snapshot_labels([(5.0, -3.5), (5.1, -3.5), (7.0, 0.0), (5.0, -3.3), (7.7, 3.5), (7.7, 3.5)],
+                             [14.2, 16.0, 40.0, 22.4, 60.0, 60.2], 0.6)
+    assert labels == [((5.0, -3.5), "14, 16, 22 s"), ((7.0, 0.0), "40 s"), ((7.7, 3.5), "60 s")]
 
 
 def test_events_to_mark_on_the_time_axes():
