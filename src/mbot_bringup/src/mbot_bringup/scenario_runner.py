@@ -203,7 +203,8 @@ class Screenshots(object):
             path = os.path.join(self.directory, name + ".png")
             for attempt in range(self.attempts):
                 try:
-                    with (self.hold() if self.hold is not None else _nothing()):
+                    hold = self.hold() if self.hold is not None else _nothing()
+                    with hold:
                         capture(self.display, path)
                     if view_drawn(path):
                         self.taken.append(path)
