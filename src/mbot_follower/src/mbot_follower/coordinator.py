@@ -18,7 +18,9 @@ turn, or a formation switch on the move, the slots move faster than a follower c
 fleet that drives on while its shape is broken is not a formation (a column must stand before a
 corridor). Followers that follow the leader's trail past a wall, or that their safety layer holds
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
-would not bring them closer.
+would not bring them closer. While the leader waits, an excuse counts once it has lasted
+``excuse_time``: a follower turning away from a wall is held by its safety layer for a moment,
+and that moment must not send the leader off without it.
 
 Except right after a formation switch on the move: the followers change places, and on the way they
 block each other (the safety layer holds one, or another robot blocks its way to the slot and it
@@ -28,6 +30,14 @@ the leader drive on every time it flickered (the corridor column formed past the
 the first regroup after a switch waits for every follower, excused or not, until all are within
 ``resume_error`` or ``regroup_timeout`` passes; held followers give way meanwhile (GiveWay), so
 they do not jam for good. The switch is over when its shape is stable or that regroup ended.
+
+A slot in a wall (a column's last slots behind a leader that starts near a wall, slots behind a
+corner) cannot be held. Its follower is left out of the shape checks (FORMING, a switch,
+ARRIVED) and of regrouping while its slot is blocked, and the reason names it: the fleet does not
+wait for a place no robot can reach. The follower counts again ``free_hold`` after its slot is
+clear (as in the metrics): a slot just out of the wall is still too close to it to drive into
+(the follower's safety layer stops it 0.8 m short of a wall), so the leader does not stop for it
+until the slot has moved on.
 
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
 coordinator records the leader's path from the poses of every update(), started anew with each
@@ -74,6 +84,8 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
+        self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
+        self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         self.topology = "star"                     # who follows whom: star or chain
 
 
@@ -113,6 +125,8 @@ class FleetCoordinator(object):
         self.paused = False
         self.assignment = None
         self.errors = None                   # ShapeErrors of the last update
+        self.blocked = []                    # followers whose slots are (or just were) in a wall
+        self._blocked_at = {}                # follower -> when its slot was last in a wall
         self.events = []                     # (time, kind, text): switches, losses, rejoins, pauses
         self._stable_since = None
         self._phase_since = 0.0
@@ -124,6 +138,7 @@ class FleetCoordinator(object):
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
+        self._excused_since = {}             # follower -> since when it is excused (regrouping)
         self._no_regroup_before = -1e9
         self._trail = Trail()                # the leader's path since the assignment (path slots)
 
@@ -213,6 +228,9 @@ class FleetCoordinator(object):
         if self.assignment is not None and self.assignment.leader in poses:
             leader = poses[self.assignment.leader]
             self._trail.add(leader.x, leader.y)
+        for r in self.blocked_followers(poses):
+            self._blocked_at[r] = now
+        self.blocked = sorted(r for r, t in self._blocked_at.items() if now - t < self.config.free_hold)
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
         if self._switch_started is not None and stable:
@@ -225,6 +243,8 @@ class FleetCoordinator(object):
             if stable or timed_out:
                 why = "formation reached" if stable else "formation not reached in %.0f s (%s); navigating anyway" % (
                     self.config.forming_timeout, self._worst_follower(poses))
+                if self.blocked:
+                    why += " (%s in a wall: joining on the way)" % self._blocked_text()
                 self._set_phase(NAVIGATING, now, why)
                 self._leader_done_at = None
                 actions.append(("goal", self.leader, self.target))
@@ -260,7 +280,10 @@ class FleetCoordinator(object):
             self._leader_done_at = now
         if self._leader_done_at is not None:
             if stable:
-                self._set_phase(ARRIVED, now, "the leader is at the target and the formation is stable")
+                why = "the leader is at the target and the formation is stable"
+                if self.blocked:
+                    why += " (%s in a wall)" % self._blocked_text()
+                self._set_phase(ARRIVED, now, why)
             elif now - self._leader_done_at > self.config.arrive_timeout:
                 self._set_phase(ARRIVED, now, "the leader is at the target; formation not stable after %.0f s (%s)" % (
                     self.config.arrive_timeout, self._worst_follower(poses)))
@@ -272,6 +295,16 @@ class FleetCoordinator(object):
         else the actions (possibly none) of waiting."""
         if self._switch_waits:
             excused = ()
+        for r in list(self._excused_since):
+            if r not in excused:
+                del self._excused_since[r]
+        for r in excused:
+            self._excused_since.setdefault(r, now)
+        if self._regroup_since is not None:
+            # while the leader waits, a follower's excuse must last: one cycle held by its safety
+            # layer (turning away from a wall) would let the leader drive off from it
+            excused = [r for r in excused if now - self._excused_since[r] >= self.config.excuse_time]
+        excused = set(excused) | set(self.blocked)
         errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
         if self._regroup_since is None:
@@ -360,6 +393,7 @@ class FleetCoordinator(object):
             self.assignment = None
             return []
         leader_pose = poses[self.leader]
+        self._blocked_at = {}
         # the leader's path starts here: path slots are the rigid slots at first
         self._trail.start(leader_pose.x, leader_pose.y, leader_pose.theta)
         if len(self.members) == 1:  # the leader alone: no shape to keep
@@ -391,7 +425,7 @@ class FleetCoordinator(object):
         if a is None or a.leader not in poses:
             return None
         self._last_leader_pose = poses[a.leader]
-        robots = [a.leader] + [r for r in a.slots if r != a.leader and r in poses]
+        robots = [a.leader] + [r for r in a.slots if r != a.leader and r in poses and r not in self.blocked]
         if len(robots) < 2:
             return None
         slots = self.slot_poses(poses)
@@ -405,8 +439,9 @@ class FleetCoordinator(object):
         e = self.errors
         ok = e is not None and e.edge_max < self.config.form_edge_tolerance and \
             e.heading_max < self.config.form_heading_tolerance
-        if len(self.members) == 1 and self.assignment is not None:
-            ok = True
+        if self.assignment is not None and all(r == self.assignment.leader or r in self.blocked
+                                               for r in self.members):
+            ok = True  # nobody but the leader can be checked (alone, or every other slot blocked)
         if not ok:
             self._stable_since = None
             return False
@@ -434,6 +469,18 @@ class FleetCoordinator(object):
             result[r] = (math.hypot(poses[r].x - slot.x, poses[r].y - slot.y),
                          normalize_angle(poses[r].theta - slot.theta))
         return result
+
+    def blocked_followers(self, poses):
+        """The followers whose slots (placed at the leader's pose now) are in a wall of the map."""
+        if self.free_space is None:
+            return []
+        a = self.assignment
+        return sorted(r for r, slot in self.slot_poses(poses).items()
+                      if r != a.leader and not self.free_space.is_free(slot.x, slot.y))
+
+    def _blocked_text(self):
+        return "%s %s" % (" and ".join("%s's slot" % r for r in self.blocked),
+                          "is" if len(self.blocked) == 1 else "are")
 
     def _worst_follower(self, poses):
         errors = self.slot_errors(poses)

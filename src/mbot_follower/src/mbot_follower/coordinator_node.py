@@ -102,6 +102,7 @@ class CoordinatorNode(object):
         self.assignment_pub = rospy.Publisher("/fleet/assignment", FleetAssignment, queue_size=1, latch=True)
         self.marker_pub = rospy.Publisher("/fleet/markers", MarkerArray, queue_size=1)
         self.tf_broadcaster = tf2_ros.TransformBroadcaster()
+        self._view_stamp = None
         # In lockstep the simulator holds sim time until this heartbeat is current: a loss is
         # judged in sim seconds, which must not run away while a busy machine starves this node.
         self.heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10)
@@ -296,8 +297,10 @@ class CoordinatorNode(object):
         from geometry_msgs.msg import TransformStamped
 
         center = markers.fleet_center(self.core.members, poses)
-        if not self.params["view_frame"] or center is None:
+        # tf2 warns (TF_REPEATED_DATA) in every listener about a second transform with one stamp
+        if not self.params["view_frame"] or center is None or stamp == self._view_stamp:
             return
+        self._view_stamp = stamp
         t = TransformStamped()
         t.header.stamp = stamp
         t.header.frame_id = "map"

@@ -5,9 +5,10 @@ Every control period (sim time) it
 1. reads its private parameters again (every ``~param_refresh`` s), so ``rosparam set`` of a gain
    or limit takes effect without a restart;
 2. looks up its pose in the leader's frame from tf2 (``<leader>/base_link -> <ns>/base_link``),
-   polling up to ``~pose_wait`` of wall time for a transform at most ``~max_pose_age`` old; a
-   failed or stale lookup skips the control law and holds the robot still: it never acts on
-   old data. Lookups and failures are counted and published;
+   polling up to ``~pose_wait`` of wall time (0.5 s under the simulator's lockstep, where the wait
+   costs no sim time) for a transform at most ``~max_pose_age`` old; a failed or stale lookup
+   skips the control law and holds the robot still: it never acts on old data. Lookups and
+   failures are counted and published;
 3. picks its target: its slot from ``/fleet/assignment`` (for a formation along the path, a
    column, the point of the leader's path its slot's distance behind the leader, from the
    leader's map positions recorded since the assignment: trail.path_slot), or, when the slot

@@ -13,12 +13,17 @@ from mbot_common.paths import find_maps_directory
 from mbot_navigation.fleet_launch import LOCALIZATIONS, fleet_launch_xml, read_world, run_launch_text
 
 OMNI_MODELS = ("mbot_omni",)
+#: How long a follower polls for a current tf pose under lockstep [s wall]. Sim time waits for
+#: its command meanwhile, so a longer wait costs nothing, and a loaded machine delivers /tf late.
+LOCKSTEP_POSE_WAIT = 0.5
 
 
-def controller_lines(world, controller="slot_tracking", output="log", config_file="", leader_max_vel=0.0):
+def controller_lines(world, controller="slot_tracking", output="log", config_file="", leader_max_vel=0.0,
+                     lockstep=False):
     """Launch XML lines: one follower_controller node per robot of `world`, and, when
     leader_max_vel > 0, that speed limit [m/s] for every robot's move_base (any robot may lead):
-    followers can only keep up with a leader slower than themselves."""
+    followers can only keep up with a leader slower than themselves. Under the simulator's
+    `lockstep` the controllers wait LOCKSTEP_POSE_WAIT for a current pose."""
     lines = []
     for robot in world.robots:
         if leader_max_vel > 0.0:
@@ -30,8 +35,20 @@ def controller_lines(world, controller="slot_tracking", output="log", config_fil
             lines.append('    <rosparam file=%s command="load"/>' % quoteattr(config_file))
         lines.append('    <param name="controller" value=%s/>' % quoteattr(controller))
         lines.append('    <param name="omni" value="%s"/>' % ("true" if robot.model in OMNI_MODELS else "false"))
+        if lockstep:
+            lines.append('    <param name="pose_wait" value="%g"/>' % LOCKSTEP_POSE_WAIT)
         lines.append("  </node>")
     return lines
+
+
+def launch_bool(text):
+    """A roslaunch boolean (true/false/1/0, any case), as roslaunch reads them."""
+    import argparse
+
+    value = {"true": True, "1": True, "false": False, "0": False}.get(text.strip().lower())
+    if value is None:
+        raise argparse.ArgumentTypeError("expected true or false, got %r" % text)
+    return value
 
 
 def parse_args(argv):
@@ -45,6 +62,8 @@ def parse_args(argv):
     parser.add_argument("--leader-max-vel", type=float, default=0.0, help="move_base speed limit [m/s]; 0: the model's")
     parser.add_argument("--config-dir", default="", help="folder with the nav_*.yaml files")
     parser.add_argument("--output", default="log", choices=("log", "screen"))
+    parser.add_argument("--lockstep", default=False, type=launch_bool,
+                        help="true: the simulator runs in lockstep (longer tf waits cost no sim time)")
     return parser.parse_args([a for a in argv if ":=" not in a])
 
 
@@ -64,7 +83,8 @@ def main(argv=None):
         world = read_world(args.world, maps)
         text = fleet_launch_xml(world, args.localization, config_dir=args.config_dir, output=args.output,
                                 extra_lines=controller_lines(world, args.controller, args.output,
-                                                             args.controller_config, args.leader_max_vel))
+                                                             args.controller_config, args.leader_max_vel,
+                                                             args.lockstep))
     except ValueError as error:
         print("formation_fleet: %s" % error, file=sys.stderr)
         return 1

@@ -109,6 +109,58 @@ def test_targets_in_walls_or_off_the_map_are_refused():
     assert check_target(Pose2D(5.0, 0.0, 0.0), FakeFreeSpace()) is None
 
 
+class WallBehind(object):
+    """Free inside |x|, |y| < 10 except a wall at x < -4 (behind a leader at the origin)."""
+
+    def cell(self, x, y):
+        return (int(y), int(x)) if abs(x) < 10 and abs(y) < 10 else None
+
+    def is_free(self, x, y):
+        return self.cell(x, y) is not None and x > -4.0
+
+
+def test_a_slot_in_a_wall_does_not_hold_up_forming_and_is_named():
+    # A column of 3 at spacing 2.5 behind a leader at the origin: the last slot is at x = -5, in
+    # the wall. The follower there stands 1 m short of it; the other is on its slot.
+    core = FleetCoordinator(ROBOTS, "leader", "column", 2.5, CoordinatorConfig(), free_space=WallBehind())
+    poses = start_poses()
+    core.set_goal(Pose2D(5.0, 0.0, 0.0), 0.0, poses)
+    slots = core.slot_poses(poses)
+    last = min(slots, key=lambda r: slots[r].x)
+    other = [r for r in ROBOTS if r not in ("leader", last)][0]
+    t, actions = 0.0, []
+    while core.phase == FORMING and t < 5.0:
+        t += 0.1
+        poses = {"leader": Pose2D(0.0, 0.0, 0.0), other: Pose2D(slots[other].x, slots[other].y, 0.0),
+                 last: Pose2D(slots[last].x + 1.0, 0.0, 0.0)}
+        actions = core.update(t, poses, heard(t))
+    assert core.phase == NAVIGATING and t < 1.0, core.reason
+    assert ("goal", "leader", Pose2D(5.0, 0.0, 0.0)) in actions
+    assert core.blocked == [last] and "%s's slot is in a wall" % last in core.reason
+    # driving: the blocked follower is not waited for ...
+    t += 0.1
+    assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == [] and core.phase == NAVIGATING
+    # ... nor just after its slot came out of the wall (the leader has moved on) ...
+    leader = Pose2D(2.0, 0.0, 0.0)
+    poses = at_slots(core, leader)
+    poses[last] = Pose2D(poses[last].x - 1.5, 0.0, 0.0)
+    t += 0.1
+    assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == [] and core.blocked == [last]
+    # ... but once the slot has been clear for free_hold: 1.5 m off it, the leader waits
+    t += core.config.free_hold
+    assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    assert core.blocked == [] and "waits for %s" % last in core.reason
+
+
+def test_forming_without_a_map_still_waits_for_every_follower():
+    core = FleetCoordinator(ROBOTS, "leader", "column", 2.5, CoordinatorConfig())
+    poses = start_poses()
+    core.set_goal(Pose2D(5.0, 0.0, 0.0), 0.0, poses)
+    for i in range(30):
+        core.update(0.1 * (i + 1), poses, heard(0.1 * (i + 1)))
+    assert core.phase == FORMING and core.blocked == []
+
+
 def test_unknown_formation_is_refused_and_the_assignment_stays():
     core = make()
     t, poses, _ = formed_and_navigating(core)
@@ -267,6 +319,20 @@ def test_a_follower_on_the_trail_does_not_hold_up_the_leader():
     off = dict(poses)
     off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
     assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1"]) == []
+
+
+def test_while_the_leader_waits_a_moments_excuse_does_not_send_it_off():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
+    assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
+    # held by its safety layer for a moment (turning away from a wall): the leader keeps waiting
+    for k in range(2, 11):
+        assert core.update(t + 0.1 * k, off, heard(t + 0.1 * k), excused=["follower_1"]) == [], k
+    # held for excuse_time (since t + 0.2): now it is excused, and the leader drives on
+    t += 0.2 + core.config.excuse_time + 0.05
+    assert core.update(t, off, heard(t), excused=["follower_1"]) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
 
 
 def test_regrouping_gives_up_after_its_timeout():
