@@ -1,6 +1,6 @@
 """/fleet/markers for rviz: each slot (a disc where a follower belongs, and a thin line to it from
 a follower that is not there yet), a line from the leader to each follower, a label with each
-robot's role and slot error, a red "lost" under a lost robot, the fleet state above the leader
+robot's role and slot error, a red "lost" under a lost robot, the fleet state above the fleet
 (with the lost robots), and a red cylinder in front of the leader while the fleet is paused; and
 the centre of the fleet, where the `fleet` frame is that rviz's view can follow."""
 import math
@@ -84,7 +84,10 @@ def fleet_markers(core, poses, stamp):
         lost.text = "lost"
         array.markers.append(lost)
     state = _marker("state", 0, Marker.TEXT_VIEW_FACING, stamp, PAUSE_COLOR if core.paused else TEXT_COLOR)
-    state.pose.position.x, state.pose.position.y, state.pose.position.z = leader.x, leader.y + 1.2, 0.5
+    # above the fleet's top robot and its name: a long text beside the leader covered a follower
+    state.pose.position.x = fleet_center(list(poses), poses)[0]
+    state.pose.position.y = max(p.y for p in poses.values()) + 0.9
+    state.pose.position.z = 0.5
     state.scale.z = 0.3
     state.text = "%s %s%s%s" % (core.state(), core.formation, " PAUSED" if core.paused else "",
                                 " (lost: %s)" % ", ".join(sorted(core.lost)) if core.lost else "")

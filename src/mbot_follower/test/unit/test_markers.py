@@ -59,3 +59,11 @@ def test_a_lost_robot_is_labelled_and_named_in_the_state():
     # removed from the simulator (no pose): nothing to label
     gone = {r: p for r, p in poses.items() if r != "follower_1"}
     assert "lost" not in by_ns(fleet_markers(core, gone, stamp()))
+
+
+def test_the_state_is_written_above_every_robot():
+    core, poses = started()
+    state = by_ns(fleet_markers(core, poses, stamp()))["state"][0]
+    assert state.pose.position.y > max(p.y for p in poses.values()) + 0.5
+    xs = [p.x for p in poses.values()]
+    assert min(xs) <= state.pose.position.x <= max(xs)
