@@ -1,0 +1,260 @@
+// The moving obstacles layer (no ROS master): a laser scan of a walking disc, simulated here,
+// gets a predicted sweep ahead of the disc; a disc standing still, a teammate, the map's walls and
+// a track that vanished get none; a bad setting is an error naming its key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mbot_navigation/costmap/layered_costmap.h"
+#include "mbot_navigation/costmap/moving_obstacles_layer.h"
+#include "mbot_navigation/costmap/robots_layer.h"
+
+using namespace mbot_navigation;
+
+namespace
+{
+const double kInf = std::numeric_limits<double>::infinity();
+
+struct Disc
+{
+  double x, y, r;
+};
+
+/// A 360-beam scan from (ox, oy) at time t [s] of the discs and, when wall_y is finite, of a wall
+/// along y = wall_y: each beam ends at the nearest surface, or +Inf beyond 8 m.
+ScanObservation laser(double ox, double oy, double t, const std::vector<Disc>& discs, double wall_y = kInf)
+{
+  ScanObservation s;
+  s.origin_x = ox;
+  s.origin_y = oy;
+  s.range_min = 0.12;
+  s.range_max = 8.0;
+  s.stamp = t;
+  for (int i = 0; i < 360; ++i)
+  {
+    const double a = -M_PI + i * M_PI / 180.0, dx = std::cos(a), dy = std::sin(a);
+    double best = kInf;
+    for (const Disc& d : discs)
+    {
+      const double b = dx * (d.x - ox) + dy * (d.y - oy);
+      const double c = (d.x - ox) * (d.x - ox) + (d.y - oy) * (d.y - oy) - d.r * d.r;
+      if (b * b - c < 0.0) continue;
+      const double range = b - std::sqrt(b * b - c);
+      if (range > 0.0) best = std::min(best, range);
+    }
+    if (std::isfinite(wall_y) && std::abs(dy) > 1e-9 && (wall_y - oy) / dy > 0.0) best = std::min(best, (wall_y - oy) / dy);
+    s.beams.push_back({a, best <= s.range_max ? best : kInf});
+  }
+  return s;
+}
+
+/// Cost of the master cell holding (x, y) [m].
+int costAt(const Costmap2D& m, double x, double y)
+{
+  unsigned mx, my;
+  if (!m.worldToMap(x, y, mx, my)) return -1;
+  return m.cost(mx, my);
+}
+
+/// A 6 x 6 m costmap (robot radius 0.15 m) with only the moving obstacles layer.
+struct Fixture
+{
+  explicit Fixture(const MovingObstaclesConfig& config = defaults())
+  {
+    LayeredCostmapConfig c;
+    c.width = c.height = 6.0;
+    c.resolution = 0.05;
+    c.robot_radius = 0.15;
+    costmap = std::make_unique<LayeredCostmap>(c);
+    layer = &static_cast<MovingObstaclesLayer&>(costmap->addLayer(std::make_unique<MovingObstaclesLayer>(config)));
+  }
+  static MovingObstaclesConfig defaults()
+  {
+    MovingObstaclesConfig c;
+    c.prediction_time = 2.0;  // as nav_costmaps.yaml
+    return c;
+  }
+  void scan(const ScanObservation& s)
+  {
+    layer->addObservation(s);
+    costmap->updateMap(Pose2D{s.origin_x, s.origin_y, 0.0});
+  }
+  int at(double x, double y) const { return costAt(costmap->costmap(), x, y); }
+  int predictedTracks() const
+  {
+    int n = 0;
+    for (const MovingTrack& k : layer->tracks()) n += layer->predicted(k);
+    return n;
+  }
+  int nonFreeCells() const
+  {
+    const Costmap2D& m = costmap->costmap();
+    int n = 0;
+    for (unsigned i = 0; i < m.sizeX() * m.sizeY(); ++i) n += m.data()[i] != cost::FREE;
+    return n;
+  }
+  std::unique_ptr<LayeredCostmap> costmap;
+  MovingObstaclesLayer* layer = nullptr;
+};
+
+/// A person (radius 0.25 m) from (3.0, 1.5) at (vx, vy) [m/s], seen from (1.0, 2.0) every 0.1 s
+/// for `seconds`; returns where the person is at the last scan.
+std::pair<double, double> walk(Fixture& f, double vx, double vy, double seconds = 1.0)
+{
+  double x = 3.0, y = 1.5;
+  for (int k = 0; k <= static_cast<int>(std::lround(seconds / 0.1)); ++k)
+  {
+    const double t = 10.0 + 0.1 * k;
+    x = 3.0 + vx * 0.1 * k;
+    y = 1.5 + vy * 0.1 * k;
+    f.scan(laser(1.0, 2.0, t, {{x, y, 0.25}}));
+  }
+  return {x, y};
+}
+}  // namespace
+
+TEST(MovingObstaclesLayer, WalkingPersonGetsASweepAheadInItsDirectionOfMotion)
+{
+  Fixture f;
+  const auto [x, y] = walk(f, 0.0, 0.6);  // walking +y at 0.6 m/s
+  ASSERT_EQ(f.layer->tracks().size(), 1u);
+  const MovingTrack& k = f.layer->tracks()[0];
+  ASSERT_TRUE(f.layer->predicted(k));
+  // The laser sees the near side, whose centre shifts a little as the bearing turns.
+  EXPECT_NEAR(k.vx, 0.0, 0.1);
+  EXPECT_NEAR(k.vy, 0.6, 0.1);
+  // Ahead: the person covers 1.2 m in prediction_time 2 s; the sweep costs 200 (passable).
+  EXPECT_EQ(f.at(x + 0.025, y + 0.6), 200);
+  EXPECT_EQ(f.at(x + 0.025, y + 1.2), 200);
+  EXPECT_EQ(f.at(x + 0.025, y + 1.2 + 0.25 + 0.15 + 0.15), cost::FREE);  // past sweep + radii
+  // Behind and beside it: nothing (this layer draws only the prediction).
+  EXPECT_EQ(f.at(x + 0.025, y - 0.6), cost::FREE);
+  EXPECT_EQ(f.at(x + 0.8, y + 0.6), cost::FREE);
+  EXPECT_EQ(f.at(x - 0.8, y + 0.6), cost::FREE);
+
+  // The other way round, the sweep is on the other side.
+  Fixture g;
+  const auto [x2, y2] = walk(g, -0.5, 0.0);
+  EXPECT_EQ(g.at(x2 - 0.8, y2), 200);
+  EXPECT_EQ(g.at(x2 + 0.8, y2), cost::FREE);
+}
+
+TEST(MovingObstaclesLayer, PersonStandingStillGetsNoSweep)
+{
+  Fixture f;
+  walk(f, 0.0, 0.0, 2.0);
+  ASSERT_EQ(f.layer->tracks().size(), 1u);  // seen and tracked...
+  EXPECT_EQ(f.predictedTracks(), 0);        // ...but not moving
+  EXPECT_EQ(f.nonFreeCells(), 0);
+
+  // Nor when the robot drives past it at 0.4 m/s (the laser sees another side of it).
+  Fixture g;
+  for (int k = 0; k <= 20; ++k) g.scan(laser(1.0, 1.0 + 0.04 * k, 10.0 + 0.1 * k, {{3.0, 1.5, 0.25}}));
+  EXPECT_EQ(g.predictedTracks(), 0);
+  EXPECT_EQ(g.nonFreeCells(), 0);
+}
+
+TEST(MovingObstaclesLayer, TeammateIsNotTracked)
+{
+  // A teammate walks like the person; its hits are taken out as the nav node does.
+  Fixture f, unfiltered;
+  TeammateState mate;
+  mate.radius = 0.25;
+  for (int k = 0; k <= 10; ++k)
+  {
+    mate.pose = Pose2D{3.0, 1.5 + 0.06 * k, M_PI / 2};
+    const ScanObservation s = laser(1.0, 2.0, 10.0 + 0.1 * k, {{mate.pose.x, mate.pose.y, mate.radius}});
+    f.scan(withoutTeammateHits(s, {mate}, 0.15));
+    unfiltered.scan(s);
+  }
+  EXPECT_TRUE(f.layer->tracks().empty());
+  EXPECT_EQ(f.nonFreeCells(), 0);
+  EXPECT_EQ(unfiltered.predictedTracks(), 1);  // the same scans, not filtered: a sweep
+}
+
+TEST(MovingObstaclesLayer, TrackThatVanishesIsDropped)
+{
+  Fixture f;
+  const auto [x, y] = walk(f, 0.0, 0.6);
+  ASSERT_EQ(f.at(x + 0.025, y + 0.6), 200);
+  // Nobody there any more (walked out of sight): after track_timeout (0.5 s) the track and its
+  // sweep are gone.
+  double t = 11.0;
+  for (int k = 1; k <= 3; ++k) f.scan(laser(1.0, 2.0, t + 0.1 * k, {}));
+  EXPECT_EQ(f.layer->tracks().size(), 1u);  // missed 0.3 s: still kept
+  for (int k = 4; k <= 7; ++k) f.scan(laser(1.0, 2.0, t + 0.1 * k, {}));
+  EXPECT_TRUE(f.layer->tracks().empty());
+  EXPECT_EQ(f.nonFreeCells(), 0);
+
+  // reset() (clear_costmaps) forgets the tracks too.
+  walk(f, 0.0, 0.6);
+  ASSERT_EQ(f.predictedTracks(), 1);
+  f.costmap->reset();
+  EXPECT_TRUE(f.layer->tracks().empty());
+}
+
+TEST(MovingObstaclesLayer, WallsOfTheMapAreNotTrackedButAPersonBesideThemIs)
+{
+  // The static map: a wall row of cells at y = 3.0 m, longer than the laser's 8 m reach.
+  Costmap2D map(400, 400, 0.05, -9.0, -7.0);
+  for (unsigned mx = 0; mx < 400; ++mx) map.setCost(mx, 200, cost::LETHAL);
+  Fixture f;
+  f.layer->setStaticMap(&map);
+  // The robot drives along the wall; the laser sees the wall's lower face (y = 3.0).
+  for (int k = 0; k <= 20; ++k) f.scan(laser(1.0 + 0.04 * k, 2.0, 10.0 + 0.1 * k, {}, 3.0));
+  EXPECT_TRUE(f.layer->tracks().empty());
+  // A person walking along the wall 0.4 m from it is tracked and predicted.
+  for (int k = 0; k <= 10; ++k) f.scan(laser(1.0, 2.0, 13.0 + 0.1 * k, {{2.0 + 0.06 * k, 2.6 - 0.25, 0.25}}, 3.0));
+  EXPECT_EQ(f.predictedTracks(), 1);
+  // Without the map, the wall's hits are one cluster, too wide to be tracked (also its piece within
+  // obstacle_range, whose end would move with the robot).
+  Fixture g;
+  for (int k = 0; k <= 20; ++k) g.scan(laser(1.0 + 0.04 * k, 2.0, 10.0 + 0.1 * k, {}, 3.0));
+  EXPECT_EQ(g.predictedTracks(), 0);
+}
+
+TEST(MovingObstaclesLayer, BadSettingIsAnErrorNamingTheKey)
+{
+  const std::vector<std::pair<std::string, std::function<void(MovingObstaclesConfig&)>>> bad = {
+      {"prediction_time", [](MovingObstaclesConfig& c) { c.prediction_time = -1.0; }},
+      {"prediction_step", [](MovingObstaclesConfig& c) { c.prediction_step = 0.0; }},
+      {"prediction_cost", [](MovingObstaclesConfig& c) { c.prediction_cost = cost::LETHAL; }},
+      {"obstacle_range", [](MovingObstaclesConfig& c) { c.obstacle_range = 0.0; }},
+      {"static_margin", [](MovingObstaclesConfig& c) { c.static_margin = -0.1; }},
+      {"cluster_distance", [](MovingObstaclesConfig& c) { c.cluster_distance = 0.0; }},
+      {"max_size", [](MovingObstaclesConfig& c) { c.max_size = std::nan(""); }},
+      {"association_gate", [](MovingObstaclesConfig& c) { c.association_gate = -0.5; }},
+      {"velocity_window", [](MovingObstaclesConfig& c) { c.velocity_window = 0.0; }},
+      {"min_track_age", [](MovingObstaclesConfig& c) { c.min_track_age = -0.3; }},
+      {"track_timeout", [](MovingObstaclesConfig& c) { c.track_timeout = 0.0; }},
+      {"min_speed", [](MovingObstaclesConfig& c) { c.min_speed = -0.1; }},
+      {"max_speed", [](MovingObstaclesConfig& c) { c.max_speed = 0.1; }},  // below min_speed 0.15
+  };
+  EXPECT_NO_THROW(MovingObstaclesLayer{MovingObstaclesConfig()});
+  for (const auto& [key, spoil] : bad)
+  {
+    MovingObstaclesConfig c;
+    spoil(c);
+    try
+    {
+      MovingObstaclesLayer layer(c);
+      ADD_FAILURE() << key << ": accepted";
+    }
+    catch (const std::invalid_argument& e)
+    {
+      EXPECT_NE(std::string(e.what()).find("'" + key + "'"), std::string::npos) << key << ": " << e.what();
+    }
+  }
+}
+
+int main(int argc, char** argv)
+{
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
