@@ -448,7 +448,8 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
 
   // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
   if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
-  if (obstacle_layer_ || moving_layer_) scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
+  if (obstacle_layer_ || moving_layer_)
+    scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
   if (settings.publish_frequency > 0.0)
     costmap_pub_ = private_nh.advertise<nav_msgs::OccupancyGrid>(name + "/costmap", 1, true);
   grid_msg_.header.frame_id = settings.global_frame;

@@ -268,8 +268,8 @@ TEST(MoveBaseParams, MovingObstaclesLayerKeysAndErrors)
   EXPECT_NE(error.find("/moving_flat/global_costmap/moving_obstacles_"), std::string::npos) << error;
   EXPECT_NE(error.find("'association_gate'"), std::string::npos) << error;
   ros::param::set("/moving_flat_off/global_costmap/moving_obstacles_layer", false);
-  EXPECT_FALSE(readCostmapSettings(ros::NodeHandle("/moving_flat_off/global_costmap"), CostmapRosSettings())
-                   .moving_obstacles);
+  EXPECT_FALSE(
+      readCostmapSettings(ros::NodeHandle("/moving_flat_off/global_costmap"), CostmapRosSettings()).moving_obstacles);
 }
 
 namespace
@@ -310,7 +310,7 @@ TEST(MoveBaseParams, LayersAreStackedInTheListedOrder)
   // costmap_2d's pre-layer order, with ours (moving obstacles, teammates) before the inflation
   EXPECT_EQ(d.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::MOVING,
                                                    LayerKind::ROBOTS, LayerKind::INFLATION}));
-  d.costmap.rolling_window = true;                                           // no map needed
+  d.costmap.rolling_window = true;  // no map needed
   d.costmap.width = d.costmap.height = 4.0;
   d.costmap.robot_radius = 0.15;
   ParamWarnings warnings;

@@ -48,7 +48,8 @@ ScanObservation laser(double ox, double oy, double t, const std::vector<Disc>& d
       const double range = b - std::sqrt(b * b - c);
       if (range > 0.0) best = std::min(best, range);
     }
-    if (std::isfinite(wall_y) && std::abs(dy) > 1e-9 && (wall_y - oy) / dy > 0.0) best = std::min(best, (wall_y - oy) / dy);
+    if (std::isfinite(wall_y) && std::abs(dy) > 1e-9 && (wall_y - oy) / dy > 0.0)
+      best = std::min(best, (wall_y - oy) / dy);
     s.beams.push_back({a, best <= s.range_max ? best : kInf});
   }
   return s;

@@ -23,8 +23,7 @@ namespace mbot_navigation
 {
 /// @brief RobotsLayer settings: how far ahead a teammate's sweep is drawn and its cost (sweep.h).
 struct RobotsLayerConfig : SweepPrediction
-{
-};
+{};
 
 /// @brief What the fleet reports about one teammate.
 struct TeammateState
