@@ -35,6 +35,7 @@ void checkMovingObstaclesConfig(const MovingObstaclesConfig& c)
   if (!(c.min_speed >= 0.0)) throw std::invalid_argument(std::string(kWho) + ": 'min_speed' must be >= 0 [m/s]");
   if (!(c.max_speed > c.min_speed))
     throw std::invalid_argument(std::string(kWho) + ": 'max_speed' must be > 'min_speed' [m/s]");
+  if (!(c.blocked_time >= 0.0)) throw std::invalid_argument(std::string(kWho) + ": 'blocked_time' must be >= 0 [s]");
 }
 
 MovingObstaclesLayer::MovingObstaclesLayer(const MovingObstaclesConfig& config) : config_(config)
@@ -216,8 +217,25 @@ std::vector<Pose2D> MovingObstaclesLayer::predict(const MovingTrack& k) const
   return predictPoses(Pose2D{k.x, k.y, std::atan2(k.vy, k.vx)}, std::hypot(k.vx, k.vy), 0.0, 0.0, config_);
 }
 
-void MovingObstaclesLayer::updateBounds(const Pose2D& /*robot*/, Bounds& bounds)
+std::vector<Pose2D> MovingObstaclesLayer::blocked(const MovingTrack& k) const
 {
+  const std::vector<Pose2D> poses = predict(k);
+  std::vector<Pose2D> out;
+  for (size_t i = 1; i < poses.size(); ++i)
+  {
+    const double ahead = std::min(i * config_.prediction_step, config_.prediction_time);  // [s]
+    if (ahead > config_.blocked_time + 1e-9) break;
+    // Our robot already in the body's way: a LETHAL body on it would leave it no move at all
+    // (every trajectory starts inside the inflated cells), so this track stays passable.
+    if (std::hypot(poses[i].x - robot_.x, poses[i].y - robot_.y) <= k.radius + robot_radius_) return {};
+    out.push_back(poses[i]);
+  }
+  return out;
+}
+
+void MovingObstaclesLayer::updateBounds(const Pose2D& robot, Bounds& bounds)
+{
+  robot_ = robot;
   std::stable_sort(pending_.begin(), pending_.end(),
                    [](const ScanObservation& a, const ScanObservation& b) { return a.stamp < b.stamp; });
   for (const ScanObservation& scan : pending_) track(scan);
@@ -235,7 +253,11 @@ void MovingObstaclesLayer::updateBounds(const Pose2D& /*robot*/, Bounds& bounds)
 void MovingObstaclesLayer::updateCosts(Costmap2D& master, const CellWindow& w)
 {
   for (const MovingTrack& k : tracks_)
-    if (predicted(k)) drawSweep(master, w, predict(k), k.radius + robot_radius_, config_.prediction_cost);
+  {
+    if (!predicted(k)) continue;
+    drawSweep(master, w, predict(k), k.radius + robot_radius_, config_.prediction_cost);
+    for (const Pose2D& p : blocked(k)) drawDisc(master, w, p.x, p.y, k.radius, cost::LETHAL);
+  }
 }
 
 }  // namespace mbot_navigation

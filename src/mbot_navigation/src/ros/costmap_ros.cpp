@@ -78,7 +78,8 @@ const std::vector<std::string> kFlatLayerKeys = {"static_map",
                                                  "moving_obstacles_min_track_age",
                                                  "moving_obstacles_track_timeout",
                                                  "moving_obstacles_min_speed",
-                                                 "moving_obstacles_max_speed"};
+                                                 "moving_obstacles_max_speed",
+                                                 "moving_obstacles_blocked_time"};
 
 /// The static layer's keys of `p` (the costmap's namespace, or the layer's).
 void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
@@ -183,6 +184,7 @@ void readMovingLayer(StrictParams& p, const std::string& prefix, const std::stri
   m.track_timeout = p.getDouble(prefix + "track_timeout", m.track_timeout);
   m.min_speed = p.getDouble(prefix + "min_speed", m.min_speed);
   m.max_speed = p.getDouble(prefix + "max_speed", m.max_speed);
+  m.blocked_time = p.getDouble(prefix + "blocked_time", m.blocked_time);
   try
   {
     checkMovingObstaclesConfig(m);

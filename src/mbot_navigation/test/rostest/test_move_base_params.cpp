@@ -410,6 +410,7 @@ std::vector<std::string> differences(const CostmapRosSettings& a, const CostmapR
   compare("moving.track_timeout", a.moving.track_timeout, b.moving.track_timeout);
   compare("moving.min_speed", a.moving.min_speed, b.moving.min_speed);
   compare("moving.max_speed", a.moving.max_speed, b.moving.max_speed);
+  compare("moving.blocked_time", a.moving.blocked_time, b.moving.blocked_time);
   compare("layer_order", order(a.layer_order), order(b.layer_order));
   return out;
 }

@@ -1,6 +1,7 @@
 // The moving obstacles layer (no ROS master): a laser scan of a walking disc, simulated here,
-// gets a predicted sweep ahead of the disc; a disc standing still, a teammate, the map's walls and
-// a track that vanished get none; a bad setting is an error naming its key.
+// gets a predicted sweep ahead of the disc, not passable over its first blocked_time unless our
+// robot is already in it; a disc standing still, a teammate, the map's walls and a track that
+// vanished get none; a bad setting is an error naming its key.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -79,6 +80,7 @@ struct Fixture
   {
     MovingObstaclesConfig c;
     c.prediction_time = 2.0;  // as nav_costmaps.yaml
+    c.blocked_time = 1.5;
     return c;
   }
   void scan(const ScanObservation& s)
@@ -130,8 +132,8 @@ TEST(MovingObstaclesLayer, WalkingPersonGetsASweepAheadInItsDirectionOfMotion)
   // The laser sees the near side, whose centre shifts a little as the bearing turns.
   EXPECT_NEAR(k.vx, 0.0, 0.1);
   EXPECT_NEAR(k.vy, 0.6, 0.1);
-  // Ahead: the person covers 1.2 m in prediction_time 2 s; the sweep costs 200 (passable).
-  EXPECT_EQ(f.at(x + 0.025, y + 0.6), 200);
+  // Ahead: the person covers 1.2 m in prediction_time 2 s; past blocked_time (0.9 m) the sweep
+  // costs 200 (passable).
   EXPECT_EQ(f.at(x + 0.025, y + 1.2), 200);
   EXPECT_EQ(f.at(x + 0.025, y + 1.2 + 0.25 + 0.15 + 0.15), cost::FREE);  // past sweep + radii
   // Behind and beside it: nothing (this layer draws only the prediction).
@@ -142,8 +144,50 @@ TEST(MovingObstaclesLayer, WalkingPersonGetsASweepAheadInItsDirectionOfMotion)
   // The other way round, the sweep is on the other side.
   Fixture g;
   const auto [x2, y2] = walk(g, -0.5, 0.0);
-  EXPECT_EQ(g.at(x2 - 0.8, y2), 200);
+  const MovingTrack& k2 = g.layer->tracks()[0];
+  EXPECT_EQ(g.at(k2.x - 1.2, k2.y), 200);  // 1.0 m in 2 s, past the blocked 0.75 m and the body
   EXPECT_EQ(g.at(x2 + 0.8, y2), cost::FREE);
+}
+
+TEST(MovingObstaclesLayer, WhereThePersonWalksWithinBlockedTimeIsNotPassable)
+{
+  // A blind walker crossing our path: what it reaches within blocked_time is its body, LETHAL
+  // (the planners may not cut in front); only the later part of the sweep is passable.
+  Fixture f;
+  walk(f, 0.0, 0.6);
+  ASSERT_EQ(f.predictedTracks(), 1);
+  const MovingTrack k = f.layer->tracks()[0];
+  EXPECT_EQ(f.at(k.x, k.y + 0.3), cost::LETHAL);  // 0.5 s ahead
+  EXPECT_EQ(f.at(k.x, k.y + 0.6), cost::LETHAL);  // 1 s
+  EXPECT_EQ(f.at(k.x, k.y + 0.9), cost::LETHAL);  // 1.5 s: the last blocked pose
+  EXPECT_EQ(f.at(k.x, k.y + 0.9 + k.radius + 0.1), 200);
+  EXPECT_EQ(f.at(k.x, k.y + 1.2), 200);  // 2 s
+  // The body, not the sweep grown by our radius, is LETHAL (the inflation layer adds our radius).
+  EXPECT_EQ(f.at(k.x + k.radius + 0.1, k.y + 0.6), 200);
+
+  // blocked_time 0: the whole sweep passable, as teammates' sweeps are.
+  MovingObstaclesConfig passable = Fixture::defaults();
+  passable.blocked_time = 0.0;
+  Fixture g(passable);
+  walk(g, 0.0, 0.6);
+  const MovingTrack& k2 = g.layer->tracks()[0];
+  EXPECT_EQ(g.at(k2.x, k2.y + 0.6), 200);
+}
+
+TEST(MovingObstaclesLayer, RobotAlreadyInThePersonsWayGetsOnlyThePassableSweep)
+{
+  Fixture f;
+  walk(f, 0.0, 0.6);
+  const MovingTrack k = f.layer->tracks()[0];
+  ASSERT_EQ(f.at(k.x, k.y + 0.6), cost::LETHAL);
+  // Our robot stands 0.6 m ahead of the person, on its path (the person walks at it): a LETHAL
+  // body there would leave the robot no trajectory at all; the sweep stays, passable.
+  f.costmap->updateMap(Pose2D{k.x, k.y + 0.6, 0.0});
+  EXPECT_EQ(f.at(k.x, k.y + 0.3), 200);
+  EXPECT_EQ(f.at(k.x, k.y + 0.6), 200);
+  // Beside the path, out of reach (more than the person's radius and ours): blocked again.
+  f.costmap->updateMap(Pose2D{k.x + k.radius + 0.15 + 0.1, k.y + 0.6, 0.0});
+  EXPECT_EQ(f.at(k.x, k.y + 0.6), cost::LETHAL);
 }
 
 TEST(MovingObstaclesLayer, PersonStandingStillGetsNoSweep)
@@ -183,7 +227,7 @@ TEST(MovingObstaclesLayer, TrackThatVanishesIsDropped)
 {
   Fixture f;
   const auto [x, y] = walk(f, 0.0, 0.6);
-  ASSERT_EQ(f.at(x + 0.025, y + 0.6), 200);
+  ASSERT_EQ(f.at(x + 0.025, y + 1.2), 200);
   // Nobody there any more (walked out of sight): after track_timeout (0.5 s) the track and its
   // sweep are gone.
   double t = 11.0;
@@ -236,6 +280,7 @@ TEST(MovingObstaclesLayer, BadSettingIsAnErrorNamingTheKey)
       {"track_timeout", [](MovingObstaclesConfig& c) { c.track_timeout = 0.0; }},
       {"min_speed", [](MovingObstaclesConfig& c) { c.min_speed = -0.1; }},
       {"max_speed", [](MovingObstaclesConfig& c) { c.max_speed = 0.1; }},  // below min_speed 0.15
+      {"blocked_time", [](MovingObstaclesConfig& c) { c.blocked_time = -1.0; }},
   };
   EXPECT_NO_THROW(MovingObstaclesLayer{MovingObstaclesConfig()});
   for (const auto& [key, spoil] : bad)

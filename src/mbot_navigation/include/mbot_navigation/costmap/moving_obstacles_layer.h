@@ -17,7 +17,13 @@
  *      `velocity_window` seconds.
  * A track at least `min_track_age` old moving at `min_speed`..`max_speed` gets its predicted
  * sweep drawn (sweep.h, as the robots layer does for teammates): `prediction_cost`, passable,
- * over `prediction_time` ahead, grown by this robot's radius. Obstacles standing still get none:
+ * over `prediction_time` ahead, grown by this robot's radius. The first `blocked_time` of it is
+ * not a guess to weigh but the body's next steps: there the body itself is drawn LETHAL (the
+ * inflation layer then keeps our robot's radius off it), so the planners cannot cut in front of a
+ * person who would walk into the robot before it is across; they wait or pass behind. Unlike a
+ * teammate, a person does not see our plan, and a passable cost weighs little in DWA's score.
+ * A robot already inside the blocked part (a person walking at it) gets only the passable sweep
+ * of that track, or it could not move out of the way. Obstacles standing still get no sweep:
  * the obstacle layer marks them as it always did. Every update erases the previous drawing.
  */
 #pragma once
@@ -45,6 +51,7 @@ struct MovingObstaclesConfig : SweepPrediction
   double track_timeout = 0.5;     ///< a track not seen for this long is dropped [s]
   double min_speed = 0.15;        ///< slower tracks stand still (no sweep) [m/s]
   double max_speed = 2.0;         ///< faster tracks are wrong associations (no sweep) [m/s]
+  double blocked_time = 1.0;      ///< the sweep's first seconds are the body's: LETHAL [s] (0: none)
 };
 
 /// @brief Throw std::invalid_argument naming the first key of `c` that is out of range.
@@ -91,6 +98,9 @@ public:
   bool predicted(const MovingTrack& track) const;
   /// @brief The poses a track is predicted at, from its newest position to prediction_time ahead.
   std::vector<Pose2D> predict(const MovingTrack& track) const;
+  /// @brief The predicted poses (after the newest position) within blocked_time, where the
+  ///        track's body is drawn LETHAL; none when the robot is already within reach of them.
+  std::vector<Pose2D> blocked(const MovingTrack& track) const;
 
 private:
   /// @brief A cluster of hits: its centre and half its width [m].
@@ -109,6 +119,7 @@ private:
   int next_id_ = 1;
   double latest_stamp_ = -1.0;  ///< of the newest scan applied [s]
   double robot_radius_ = 0.0;   ///< this robot's radius [m]
+  Pose2D robot_;                ///< this robot, at the last updateBounds()
   Bounds last_bounds_;          ///< what the previous update drew, to erase it
 };
 
