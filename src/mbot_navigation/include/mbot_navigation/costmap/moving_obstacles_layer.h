@@ -22,8 +22,7 @@
  * inflation layer then keeps our robot's radius off it), so the planners cannot cut in front of a
  * person who would walk into the robot before it is across; they wait or pass behind. Unlike a
  * teammate, a person does not see our plan, and a passable cost weighs little in DWA's score.
- * A robot already inside the blocked part (a person walking at it) gets only the passable sweep
- * of that track, or it could not move out of the way. Obstacles standing still get no sweep:
+ * Obstacles standing still get no sweep:
  * the obstacle layer marks them as it always did. Every update erases the previous drawing.
  */
 #pragma once
@@ -99,7 +98,7 @@ public:
   /// @brief The poses a track is predicted at, from its newest position to prediction_time ahead.
   std::vector<Pose2D> predict(const MovingTrack& track) const;
   /// @brief The predicted poses (after the newest position) within blocked_time, where the
-  ///        track's body is drawn LETHAL; none when the robot is already within reach of them.
+  ///        track's body is drawn LETHAL.
   std::vector<Pose2D> blocked(const MovingTrack& track) const;
 
 private:
@@ -119,7 +118,6 @@ private:
   int next_id_ = 1;
   double latest_stamp_ = -1.0;  ///< of the newest scan applied [s]
   double robot_radius_ = 0.0;   ///< this robot's radius [m]
-  Pose2D robot_;                ///< this robot, at the last updateBounds()
   Bounds last_bounds_;          ///< what the previous update drew, to erase it
 };
 
