@@ -225,13 +225,16 @@ std::vector<Pose2D> MovingObstaclesLayer::blocked(const MovingTrack& k) const
   {
     const double ahead = std::min(i * config_.prediction_step, config_.prediction_time);  // [s]
     if (ahead > config_.blocked_time + 1e-9) break;
+    // Our robot caught well inside the body's way (see the header): passable, so it can get out.
+    if (std::hypot(poses[i].x - robot_.x, poses[i].y - robot_.y) <= k.radius + 0.5 * robot_radius_) return {};
     out.push_back(poses[i]);
   }
   return out;
 }
 
-void MovingObstaclesLayer::updateBounds(const Pose2D& /*robot*/, Bounds& bounds)
+void MovingObstaclesLayer::updateBounds(const Pose2D& robot, Bounds& bounds)
 {
+  robot_ = robot;
   std::stable_sort(pending_.begin(), pending_.end(),
                    [](const ScanObservation& a, const ScanObservation& b) { return a.stamp < b.stamp; });
   for (const ScanObservation& scan : pending_) track(scan);

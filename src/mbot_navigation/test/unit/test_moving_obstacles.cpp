@@ -1,7 +1,7 @@
 // The moving obstacles layer (no ROS master): a laser scan of a walking disc, simulated here,
-// gets a predicted sweep ahead of the disc, not passable over its first blocked_time; a disc
-// standing still, a teammate, the map's walls and a track that vanished get none; a bad setting
-// is an error naming its key.
+// gets a predicted sweep ahead of the disc, not passable over its first blocked_time unless our
+// robot is caught well inside it; a disc standing still, a teammate, the map's walls and a track
+// that vanished get none; a bad setting is an error naming its key.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -172,6 +172,22 @@ TEST(MovingObstaclesLayer, WhereThePersonWalksWithinBlockedTimeIsNotPassable)
   walk(g, 0.0, 0.6);
   const MovingTrack& k2 = g.layer->tracks()[0];
   EXPECT_EQ(g.at(k2.x, k2.y + 0.6), 200);
+}
+
+TEST(MovingObstaclesLayer, RobotCaughtInsideTheBlockedPartGetsOnlyThePassableSweep)
+{
+  Fixture f;
+  walk(f, 0.0, 0.6);
+  const MovingTrack k = f.layer->tracks()[0];
+  ASSERT_EQ(f.at(k.x, k.y + 0.6), cost::LETHAL);
+  // Our robot 0.6 m ahead, on the person's path (the person walks at it): a LETHAL body there
+  // would leave it no trajectory at all; the sweep stays, passable.
+  f.costmap->updateMap(Pose2D{k.x, k.y + 0.6, 0.0});
+  EXPECT_EQ(f.at(k.x, k.y + 0.3), 200);
+  EXPECT_EQ(f.at(k.x, k.y + 0.6), 200);
+  // Waiting beside the path, where DWA stops it (the body's radius plus its own away): blocked.
+  f.costmap->updateMap(Pose2D{k.x + k.radius + 0.15, k.y + 0.6, 0.0});
+  EXPECT_EQ(f.at(k.x, k.y + 0.6), cost::LETHAL);
 }
 
 TEST(MovingObstaclesLayer, PersonStandingStillGetsNoSweep)

@@ -22,6 +22,11 @@
  * inflation layer then keeps our robot's radius off it), so the planners cannot cut in front of a
  * person who would walk into the robot before it is across; they wait or pass behind. Unlike a
  * teammate, a person does not see our plan, and a passable cost weighs little in DWA's score.
+ * A robot caught well inside the blocked part (its centre within the body's radius plus half its
+ * own: the body came at it, or it was crossing when the part moved onto it) gets only the passable
+ * sweep of that track: a LETHAL body on it would leave it no move, not even out of the way. A
+ * robot waiting beside the part stays at least the body's radius plus its own from it (DWA keeps
+ * its footprint off LETHAL cells), so the exception does not let it creep into the path.
  * Obstacles standing still get no sweep:
  * the obstacle layer marks them as it always did. Every update erases the previous drawing.
  */
@@ -98,7 +103,7 @@ public:
   /// @brief The poses a track is predicted at, from its newest position to prediction_time ahead.
   std::vector<Pose2D> predict(const MovingTrack& track) const;
   /// @brief The predicted poses (after the newest position) within blocked_time, where the
-  ///        track's body is drawn LETHAL.
+  ///        track's body is drawn LETHAL; none when the robot is caught well inside them.
   std::vector<Pose2D> blocked(const MovingTrack& track) const;
 
 private:
@@ -118,6 +123,7 @@ private:
   int next_id_ = 1;
   double latest_stamp_ = -1.0;  ///< of the newest scan applied [s]
   double robot_radius_ = 0.0;   ///< this robot's radius [m]
+  Pose2D robot_;                ///< this robot, at the last updateBounds()
   Bounds last_bounds_;          ///< what the previous update drew, to erase it
 };
 
