@@ -20,10 +20,12 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <message_filters/subscriber.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -41,10 +43,17 @@ public:
     pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
     cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
     map_sub_ = nh.subscribe("/map", 1, &PfLocalizationNode::onMap, this);
-    scan_sub_ = nh.subscribe("scan", 5, &PfLocalizationNode::onScan, this);
+    // As amcl: a scan is handed on once tf can place it in the odom frame at its stamp. Waiting
+    // for that inside the callback would sleep in sim time, and under the simulator's lockstep
+    // sim time waits for this node: both would wait until the simulator gives up.
+    scan_sub_.subscribe(nh, "scan", 5);
+    scan_filter_ =
+        std::make_unique<tf2_ros::MessageFilter<sensor_msgs::LaserScan>>(scan_sub_, tf_buffer_, odom_frame_, 10, nh);
+    scan_filter_->registerCallback(&PfLocalizationNode::onScan, this);
     initial_pose_sub_ = nh.subscribe("initialpose", 2, &PfLocalizationNode::onInitialPose, this);
     ROS_INFO("pf_localization: %s -> %s from %s, %d..%d particles, seed %u", global_frame_.c_str(), odom_frame_.c_str(),
-             scan_sub_.getTopic().c_str(), config_.filter.min_particles, config_.filter.max_particles, seed_);
+             scan_sub_.getSubscriber().getTopic().c_str(), config_.filter.min_particles, config_.filter.max_particles,
+             seed_);
   }
 
 private:
@@ -153,8 +162,7 @@ private:
     }
     try
     {
-      const geometry_msgs::TransformStamped t =
-          tf_buffer_.lookupTransform(base_frame_, laser_frame, ros::Time(0), ros::Duration(0.5));
+      const geometry_msgs::TransformStamped t = tf_buffer_.lookupTransform(base_frame_, laser_frame, ros::Time(0));
       mount = toPose2D(t.transform);
       mounts_[laser_frame] = mount;
       ROS_INFO("pf_localization: laser %s at (%.3f, %.3f, %.3f) in %s", laser_frame.c_str(), mount.x, mount.y,
@@ -168,8 +176,9 @@ private:
     }
   }
 
-  void onScan(const sensor_msgs::LaserScan& msg)
+  void onScan(const sensor_msgs::LaserScan::ConstPtr& scan)
   {
+    const sensor_msgs::LaserScan& msg = *scan;
     if (!localizer_)
     {
       ROS_WARN_THROTTLE(5.0, "pf_localization: waiting for the map on /map");
@@ -179,8 +188,7 @@ private:
     if (!laserMount(msg.header.frame_id, mount)) return;
     try
     {
-      odom = toPose2D(
-          tf_buffer_.lookupTransform(odom_frame_, base_frame_, msg.header.stamp, ros::Duration(0.2)).transform);
+      odom = toPose2D(tf_buffer_.lookupTransform(odom_frame_, base_frame_, msg.header.stamp).transform);
     }
     catch (const tf2::TransformException& e)
     {
@@ -239,7 +247,9 @@ private:
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Publisher pose_pub_, cloud_pub_;
-  ros::Subscriber map_sub_, scan_sub_, initial_pose_sub_;
+  ros::Subscriber map_sub_, initial_pose_sub_;
+  message_filters::Subscriber<sensor_msgs::LaserScan> scan_sub_;
+  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::LaserScan>> scan_filter_;  ///< after tf_buffer_: uses it
 };
 
 }  // namespace mbot_localization

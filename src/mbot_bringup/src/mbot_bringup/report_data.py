@@ -12,7 +12,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from mbot_common.geometry import transform_point
+from mbot_follower.trail import Trail, slot_pose
 from mbot_follower.metrics import _holds_under  # the recovery rule, used for switches too
 
 
@@ -191,12 +191,13 @@ def target_time(run):
     return run.samples[0].t if run.samples else 0.0
 
 
-def arrival_time(run):
-    """Sim time [s] of the first ARRIVED, or None."""
-    for e in sorted_events(run):
-        if e.kind == "state" and e.name == "ARRIVED":
-            return e.t
-    return None
+def arrival_time(run, last=False):
+    """Sim time [s] of the first ARRIVED (last: of the last one, the end of a route of several
+    targets), or None."""
+    times = [e.t for e in sorted_events(run) if e.kind == "state" and e.name == "ARRIVED"]
+    if not times:
+        return None
+    return times[-1] if last else times[0]
 
 
 def state_spans(run, end):
@@ -233,15 +234,15 @@ def event_marks(run):
 
 
 #: A slot assignment from t [s sim] on: leader, formation, slots {robot: (x, y)} in the leader
-#: frame [m].
-Assignment = namedtuple("Assignment", "t leader formation slots")
+#: frame [m]; along_path: the slots behind the leader lie on its path (a column).
+Assignment = namedtuple("Assignment", "t leader formation slots along_path", defaults=(False,))
 
 _SLOT = re.compile(r"(\S+)\(([^,()]+),([^,()]+)\)")
 
 
 def assignments(run, where="events.csv"):
     """[Assignment] from the collector's assignment events, whose detail reads
-    "leader L spacing S m slots r(x,y) ..."."""
+    "leader L spacing S m slots r(x,y) ..." ("... m along_path slots ..." for a column)."""
     out = []
     for e in sorted_events(run):
         if e.kind != "assignment":
@@ -257,7 +258,7 @@ def assignments(run, where="events.csv"):
         if len(words) < 2 or words[0] != "leader" or not slots:
             raise ReportError("%s: assignment at t = %.2f s: expected \"leader L spacing S m slots r(x,y) ...\", "
                               "got %r" % (where, e.t, e.detail))
-        out.append(Assignment(e.t, words[1], e.name, slots))
+        out.append(Assignment(e.t, words[1], e.name, slots, "along_path" in words))
     return out
 
 
@@ -271,12 +272,31 @@ def assignment_at(assigned, t):
     return current
 
 
-def slot_positions(assignment, leader_pose):
-    """{robot: (x, y)} [m, map] of every follower's slot for the leader at (x, y, theta)."""
+def slot_positions(assignment, leader_pose, trail=None):
+    """{robot: (x, y)} [m, map] of every follower's slot for the leader at (x, y, theta); for an
+    assignment along the path, on the leader's path `trail` (leader_trail) when it is given."""
     if assignment is None or leader_pose is None or not all(math.isfinite(v) for v in leader_pose):
         return {}
-    return dict((r, transform_point(leader_pose, off[0], off[1]))
+    trail = trail if assignment.along_path else None
+    return dict((r, tuple(slot_pose(leader_pose, off, trail)[:2]))
                 for r, off in assignment.slots.items() if r != assignment.leader)
+
+
+def leader_trail(series, assignment, i):
+    """The Trail of the assignment's leader from the first sample at or after the assignment up
+    to sample i: the path its slots lie on when it is along the path (None without a pose)."""
+    trail = None
+    for j in range(i + 1):
+        if series.t[j] + series.t0 < assignment.t - 1e-9:
+            continue
+        pose = series.pose(assignment.leader, j)
+        if pose is None:
+            continue
+        if trail is None:
+            trail = Trail()
+            trail.start(*pose)
+        trail.add(pose[0], pose[1])
+    return trail
 
 
 # --- time series ---------------------------------------------------------------------------------

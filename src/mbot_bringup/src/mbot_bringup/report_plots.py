@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from mbot_bringup.report_data import Series, arrival_time, assignment_at, assignments, event_marks, \
-    fleet_path_length, slot_positions, speeds, state_spans
+    fleet_path_length, leader_trail, slot_positions, speeds, state_spans
 
 
 class PlotStyle(object):
@@ -20,6 +20,8 @@ class PlotStyle(object):
         self.dpi = 90                     # PNG resolution [dots per inch]
         self.margin = 1.0                 # map shown around everything that moved [m]
         self.snapshots = 10               # formation snapshots on the trajectory plot (+ one per switch)
+        self.snapshot_dt = 1.0            # snapshots at least this far apart in time [s]
+        self.label_near = 0.6             # snapshots whose leaders stood this close share a time label [m]
         self.error_view = 4.0             # error axes go up to this many times the threshold ...
         self.error_median = 1.5           # ... or this many times the median error while moving
         self.speed_window = 1.0           # speeds are averaged over this long [s]
@@ -123,13 +125,14 @@ def _draw_robot(ax, pose, radius, color, filled, zorder=5):
 
 
 def snapshot_indices(series, run):
-    """Sample indices of the formation snapshots: the target, each switch, the arrival (or the
-    end), and between them evenly along the distance the fleet drove (so that they fall where
-    robots move, not while they wait), none closer to another than half that spacing."""
+    """Sample indices of the formation snapshots: the target, each switch, the last arrival (or
+    the end), and between them evenly along the distance the fleet drove (so that they fall where
+    robots move, not while they wait), none closer to another than half that spacing or than
+    snapshot_dt in time (two labels of the same second say nothing)."""
     n = len(series.t)
     path = fleet_path_length(series)
     first = min(int(np.searchsorted(series.t, 0.0)), n - 1)
-    arrived = arrival_time(run)
+    arrived = arrival_time(run, last=True)
     last = n - 1 if arrived is None else min(n - 1, int(np.searchsorted(series.t, arrived - series.t0)))
     first = min(first, last)
     apart = 0.5 * (path[last] - path[first]) / max(1, STYLE.snapshots - 1)
@@ -138,9 +141,25 @@ def snapshot_indices(series, run):
     chosen = sorted(set(fixed))
     for d in np.linspace(path[first], path[last], STYLE.snapshots):
         i = min(last, int(np.searchsorted(path, d)))
-        if i not in chosen and all(abs(path[i] - path[j]) >= apart for j in chosen):
+        if i not in chosen and all(abs(path[i] - path[j]) >= apart and abs(series.t[i] - series.t[j]) >= STYLE.snapshot_dt
+                                   for j in chosen):
             chosen.append(i)
     return sorted(chosen)
+
+
+def snapshot_labels(positions, times, near):
+    """One time label per place: [((x, y), "14, 16, 22 s")] for the snapshots whose leader stood
+    within `near` [m] of the first one there (the fleet waiting while it forms or switches)."""
+    groups = []   # [(x, y), [t, ...]]
+    for (x, y), t in zip(positions, times):
+        for place, ts in groups:
+            if math.hypot(x - place[0], y - place[1]) < near:
+                ts.append(t)
+                break
+        else:
+            groups.append(((x, y), [t]))
+    return [(place, ", ".join("%.0f" % t for t in sorted(set(round(t) + 0.0 for t in ts))) + " s")
+            for place, ts in groups]
 
 
 def plot_trajectories(run, world, colors, path, radius):
@@ -158,7 +177,7 @@ def plot_trajectories(run, world, colors, path, radius):
             first, last = finite[0], finite[-1]
             ax.plot(series.x[r][first], series.y[r][first], "o", ms=11, mfc="none", mec=colors[r], mew=2, zorder=6)
             ax.plot(series.x[r][last], series.y[r][last], "s", ms=9, color=colors[r], mec="black", zorder=6)
-    labelled = []   # leader positions with a time label: labels at the same place stack up
+    labelled, label_times = [], []   # leader position and time of each snapshot
     for i in snapshot_indices(series, run):
         leader = series.pose(series.leader[i], i)
         for r in series.robots:
@@ -170,11 +189,11 @@ def plot_trajectories(run, world, colors, path, radius):
                 ax.plot([leader[0], pose[0]], [leader[1], pose[1]], "-", color="#555555", lw=0.8, zorder=4)
             _draw_robot(ax, pose, radius, "#999999" if lost else colors[r], filled=False)
         if leader is not None:
-            level = sum(1 for p in labelled if math.hypot(p[0] - leader[0], p[1] - leader[1]) < 0.6)
-            labelled.append(leader)
-            ax.annotate("%.0f s" % (round(series.t[i]) + 0.0), (leader[0], leader[1]), xytext=(0, 9 + 11 * level),
-                        textcoords="offset points", ha="center", fontsize=8, zorder=7,
-                        bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+            labelled.append(leader[:2])
+            label_times.append(series.t[i])
+    for (x, y), text in snapshot_labels(labelled, label_times, STYLE.label_near):
+        ax.annotate(text, (x, y), xytext=(0, 9), textcoords="offset points", ha="center", fontsize=8, zorder=7,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
     for m in event_marks(run):
         i = _index_at(series, m.t - series.t0)
         if m.kind == "switch":
@@ -429,7 +448,8 @@ def write_animation(run, world, colors, path, radius):
             t = series.t[i]
             leader_name = series.leader[i]
             leader = series.pose(leader_name, i)
-            slots = slot_positions(assignment_at(assigned, t + series.t0), leader)
+            a = assignment_at(assigned, t + series.t0)
+            slots = slot_positions(a, leader, leader_trail(series, a, i) if a is not None and a.along_path else None)
             recent = (series.t >= t - STYLE.trail) & (series.t <= t)
             for r, (trail, slot, error, link, disc, tick, name) in artists.items():
                 pose = series.pose(r, i)

@@ -9,8 +9,8 @@ The runner
 2. starts `roslaunch mbot_bringup fleet.launch` with its own master on a free port (lockstep at
    real_time_factor 0 unless --real-time, rviz if there is a DISPLAY and not --no-rviz, a rosbag);
 3. plays the timeline in sim time (ScenarioPlayer), showing one status line, and takes rviz
-   screenshots at moments (forming, mid_route, switch_<formation>, loss, arrival, and the
-   timeline's own `screenshot` steps);
+   screenshots at moments (forming, mid_route: halfway along the timeline's longest route,
+   switch_<formation>, loss, arrival, and the timeline's own `screenshot` steps);
 4. stops what it started (by PID: SIGINT to roslaunch, which stops its nodes; later signals only
    to its own process group) at the end, on a timeout or on Ctrl-C;
 5. judges the criteria from the metrics collector's files (load_run / summarize), writes
@@ -227,7 +227,11 @@ class ScenarioPlayer(object):
         self.paused = False
         self.states_seen = 0
         self.goals_done_sent = False
-        self.mid_route = None      # (start (x, y), target (x, y)) of the first route, until its screenshot
+        self.mid_route = None      # (start (x, y), target (x, y)) of the route being shot, until its screenshot
+        self.mid_route_taken = False
+        # the legs between the timeline's targets: the mid-route shot goes to the longest route
+        targets = [s.arg for s in self.timeline.steps if s.action == "target"]
+        self.later_legs = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(targets, targets[1:])]
         self.forming_shot = False
 
     def _on_result(self, msg, robot):
@@ -316,6 +320,7 @@ class ScenarioPlayer(object):
             if lead is not None and math.hypot(lead[1].x - gx, lead[1].y - gy) <= 0.5 * math.hypot(gx - sx, gy - sy):
                 self._shot_later(t, "mid_route")
                 self.mid_route = None
+                self.mid_route_taken = True
 
     def _shot_later(self, t, name):
         if self.screenshots is not None:
@@ -338,11 +343,13 @@ class ScenarioPlayer(object):
         if step.action == "target":
             self.target_pub.publish(self.Pose2DMsg(a[0], a[1], a[2]))
             self.targets += 1
-            if self.mid_route is None and self.targets == 1:
+            if not self.mid_route_taken:
                 with self.probe.lock:
                     leader = self.probe.status.leader if self.probe.status else ""
                     lead = self.probe.truth.get(leader)
-                if lead is not None:
+                # this route gets the shot unless a later leg of the timeline is longer
+                later = self.later_legs[self.targets - 1:]
+                if lead is not None and math.hypot(a[0] - lead[1].x, a[1] - lead[1].y) >= max(later + [0.0]):
                     self.mid_route = ((lead[1].x, lead[1].y), (a[0], a[1]))
             return True, "sent"
         if step.action == "formation":

@@ -6,11 +6,11 @@ import os
 import numpy as np
 import pytest
 
-from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, assignment_at, assignments, \
+from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, arrival_time, assignment_at, assignments, \
     compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, speeds, \
     switch_settling
 from mbot_bringup.colors import robot_colors
-from mbot_bringup.report_plots import error_limit, snapshot_indices
+from mbot_bringup.report_plots import error_limit, snapshot_indices, snapshot_labels
 from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize
 
 FIXTURE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "run_trio")
@@ -159,6 +159,26 @@ def test_snapshots_fall_where_the_fleet_moves():
     assert 8 <= len(chosen) <= 13
 
 
+def test_snapshots_reach_the_last_arrival_of_a_route_of_several_targets():
+    """Two targets: ARRIVED at 10 s, then the fleet drives on and arrives again at 30 s; the
+    snapshots cover the second leg too, none within a second of another."""
+    run = load_run(os.path.join(FIXTURE, "metrics"))
+    first = arrival_time(run)
+    run.events.append(Event(first - 30.0, "state", "ARRIVED", "an earlier target", NAN, NAN))
+    series = Series(run)
+    times = [series.t[i] for i in snapshot_indices(series, run)]
+    assert arrival_time(run) == pytest.approx(first - 30.0)
+    assert arrival_time(run, last=True) == pytest.approx(first)
+    assert times[-1] == pytest.approx(51.75)
+    assert min(b - a for a, b in zip(times, times[1:])) >= 1.0 - 1e-9
+
+
+def test_snapshots_at_one_place_share_one_time_label():
+    labels = snapshot_labels([(5.0, -3.5), (5.1, -3.5), (7.0, 0.0), (5.0, -3.3), (7.7, 3.5), (7.7, 3.5)],
+                             [14.2, 16.0, 40.0, 22.4, 60.0, 60.2], 0.6)
+    assert labels == [((5.0, -3.5), "14, 16, 22 s"), ((7.0, 0.0), "40 s"), ((7.7, 3.5), "60 s")]
+
+
 def test_events_to_mark_on_the_time_axes():
     run = Run()
     run.events = [Event(5.0, "contact", "follower_1", "map", 1.0, 2.0),
@@ -171,3 +191,31 @@ def test_events_to_mark_on_the_time_axes():
     assert [(m.t, m.kind, m.label) for m in event_marks(run)] == [
         (2.0, "pause", "pause"), (3.0, "loss", "lost follower_2"), (4.0, "rejoin", "follower_2 back"),
         (5.0, "contact", "contact follower_1-map"), (6.0, "fault", "fault follower_1")]
+
+
+def test_a_column_along_the_path_has_its_slots_on_the_leaders_path():
+    from mbot_bringup.report_data import leader_trail
+    from mbot_follower.fleet_io import Assignment
+    from mbot_follower.metrics import MetricsCollector
+
+    def l_path(s):   # 1.5 m along +x from (0, 0), then along +y
+        return (s, 0.0, 0.0) if s <= 1.5 else (1.5, s - 1.5, math.pi / 2)
+
+    column = {"L": (0.0, 0.0), "a": (-1.0, 0.0), "b": (-2.0, 0.0)}
+    c = MetricsCollector()
+    c.on_assignment(0.0, Assignment("L", "column", 1.0, column, {r: "L" for r in column}, True))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    for k in range(150):                  # the leader drives the L at 1 m/s, the column on its path
+        t = k / 50.0
+        for r, (x, _) in column.items():
+            c.on_pose(r, t, *l_path(t + x))
+    a = assignments(c.run)[0]
+    assert a.along_path and a.slots == column
+    series = Series(c.run)
+    i = len(series.t) - 1                 # t = 2.9 s: a at (1.5, 0.4), b at (0.9, 0) before the corner
+    leader = series.pose("L", i)
+    on_path = slot_positions(a, leader, leader_trail(series, a, i))
+    for r in ("a", "b"):
+        assert on_path[r] == pytest.approx(series.pose(r, i)[:2], abs=1e-9)
+    rigid = slot_positions(a, leader)      # no trail: rigid slots, b's 0.85 m off
+    assert math.hypot(rigid["b"][0] - 0.9, rigid["b"][1]) == pytest.approx(math.hypot(0.6, 0.6))

@@ -8,8 +8,13 @@ distances, robots side by side that switch to a column tie (either may take the 
 the wrong choice makes a robot overtake another, which in a corridor it cannot. Squared
 distances break the tie the right way, and their optimum never has two straight paths crossing
 (the CAPT result of Turpin, Michael and Kumar). The leader does not move to a slot: slot 0 is
-wherever it is. Pure numpy/scipy, no ROS.
+wherever it is. A single file (a column) is assigned in order along the leader's heading
+instead (assign_single_file): robots mirrored about the leader's axis, as a diamond's two sides,
+tie even in squared distances, and the wrong choice sends one behind the other it must pass.
+Pure numpy/scipy, no ROS.
 """
+import math
+
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
@@ -54,6 +59,27 @@ def assign_slots(positions, slot_positions, leader_index=0):
         rows, cols = linear_sum_assignment(cost)
         for a, b in zip(rows, cols):
             slot_of[followers[a]] = int(b) + 1
+    return slot_of
+
+
+def assign_single_file(positions, slot_positions, heading, leader_index=0):
+    """slot_of (as assign_slots) for a single file (a column): the follower nearest behind the
+    leader gets the slot nearest behind it, and so on, measured along the leader's heading
+    [rad]. Nobody has to pass anybody, which in a corridor nobody could; least squared travel
+    may ask for it when two robots are nearly as far from both slots (a diamond's two sides)."""
+    robots = _as_points("positions", positions)
+    slots = _as_points("slot_positions", slot_positions)
+    if len(slots) != len(robots) or not 0 <= leader_index < len(robots):
+        raise ValueError("assign_single_file: %d robots, %d slots, leader_index %r"
+                         % (len(robots), len(slots), leader_index))
+    back = np.array([-math.cos(heading), -math.sin(heading)])
+    origin = robots[leader_index]
+    followers = sorted((i for i in range(len(robots)) if i != leader_index),
+                       key=lambda i: float(np.dot(robots[i] - origin, back)))
+    file_slots = sorted(range(1, len(slots)), key=lambda k: float(np.dot(slots[k] - slots[0], back)))
+    slot_of = [0] * len(robots)
+    for i, k in zip(followers, file_slots):
+        slot_of[i] = k
     return slot_of
 
 

@@ -20,6 +20,20 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
 would not bring them closer.
 
+Except right after a formation switch on the move: the followers change places, and on the way they
+block each other (the safety layer holds one, or another robot blocks its way to the slot and it
+takes the trail): those are the robots the leader waits for. A follower's mode flickers between
+slot, trail, safety_stop and give_way while robots pass each other, and an excused follower let
+the leader drive on every time it flickered (the corridor column formed past the entrance). So
+the first regroup after a switch waits for every follower, excused or not, until all are within
+``resume_error`` or ``regroup_timeout`` passes; held followers give way meanwhile (GiveWay), so
+they do not jam for good. The switch is over when its shape is stable or that regroup ended.
+
+A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
+coordinator records the leader's path from the poses of every update(), started anew with each
+assignment, and measures the followers against those slots and their headings, so a column
+bent around a corner is formed.
+
 A goal that cannot be reached as given (a NaN, off the map, in a wall) or an unknown formation
 is refused at once: the state does not change and the message says why.
 
@@ -33,10 +47,11 @@ import math
 import numpy as np
 
 from mbot_common.geometry import Pose2D, compose, normalize_angle
-from mbot_follower.assignment import assign_slots
+from mbot_follower.assignment import assign_single_file, assign_slots
 from mbot_follower.fleet_io import Assignment
 from mbot_follower.formations import FormationError, FormationLibrary
 from mbot_follower.shape import shape_errors
+from mbot_follower.trail import Trail, slot_pose
 
 IDLE, FORMING, NAVIGATING, ARRIVED, DEGRADED, ABORTED = (
     "IDLE", "FORMING", "NAVIGATING", "ARRIVED", "DEGRADED", "ABORTED")
@@ -105,10 +120,12 @@ class FleetCoordinator(object):
         self._pause_until = None
         self._no_pause_before = -1e9
         self._switch_started = None
+        self._switch_waits = False           # after a switch: the leader waits for every follower
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
         self._no_regroup_before = -1e9
+        self._trail = Trail()                # the leader's path since the assignment (path slots)
 
     # --- what the outside sees ----------------------------------------------------------------
 
@@ -159,6 +176,7 @@ class FleetCoordinator(object):
         self.formation, self.spacing = name, spacing
         self.requested_formation = name
         self._switch_started = now
+        self._switch_waits = self.phase == NAVIGATING  # (FORMING waits for every follower anyway)
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
         # While navigating, the state stays NAVIGATING: when the robots changing places fall far
         # behind their new slots, the leader waits for them (regrouping, see update()).
@@ -185,17 +203,22 @@ class FleetCoordinator(object):
             "ABORTED: <why>"
         :param obstacle_ahead: something is close in front of the leader
         :param excused: followers off their slot for a reason the leader's waiting would not cure
-            (following the leader's trail past a wall, held by their safety layer)
+            (following the leader's trail past a wall, held by their safety layer); not after a
+            switch (module docstring)
         :returns: list of actions (module docstring)
         """
         actions = self._losses_and_rejoins(now, poses, last_heard)
         if self.assignment is None and all(r in poses for r in self.members):
             actions += self._reassign(poses, now)
+        if self.assignment is not None and self.assignment.leader in poses:
+            leader = poses[self.assignment.leader]
+            self._trail.add(leader.x, leader.y)
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
         if self._switch_started is not None and stable:
             self.events.append((now, "switched", "%s reached in %.1f s" % (self.formation, now - self._switch_started)))
             self._switch_started = None
+            self._switch_waits = False
 
         if self.phase == FORMING:
             timed_out = now - self._phase_since > self.config.forming_timeout
@@ -247,6 +270,8 @@ class FleetCoordinator(object):
         """The leader waits while a follower is far off its slot (after a sharp turn, or when a
         follower was held up) and drives on once all are close again. None: nothing to do;
         else the actions (possibly none) of waiting."""
+        if self._switch_waits:
+            excused = ()
         errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
         if self._regroup_since is None:
@@ -260,6 +285,7 @@ class FleetCoordinator(object):
         if worst is not None and worst[1] >= self.config.resume_error and not timed_out:
             return []
         self._regroup_since = None
+        self._switch_waits = False  # once: a follower that cannot reach its slot is excused again
         if timed_out:
             self._no_regroup_before = now + self.config.regroup_timeout
         self.reason = "regrouped: driving on" if not timed_out else \
@@ -333,6 +359,9 @@ class FleetCoordinator(object):
         if not all(r in poses for r in self.members):
             self.assignment = None
             return []
+        leader_pose = poses[self.leader]
+        # the leader's path starts here: path slots are the rigid slots at first
+        self._trail.start(leader_pose.x, leader_pose.y, leader_pose.theta)
         if len(self.members) == 1:  # the leader alone: no shape to keep
             self.assignment = Assignment(self.leader, self.formation, self.spacing, {self.leader: (0.0, 0.0)},
                                          {self.leader: ""})
@@ -340,10 +369,11 @@ class FleetCoordinator(object):
             return [("assignment",)]
         formation = self.library.make(self.formation, len(self.members), self.spacing, topology=self.config.topology)
         order = [self.leader] + [r for r in self.members if r != self.leader]
-        leader_pose = poses[self.leader]
         slot_world = np.array([_apply(leader_pose, o) for o in formation.offsets])
         positions = np.array([[poses[r].x, poses[r].y] for r in order])
-        slot_of = assign_slots(positions, slot_world, leader_index=0)
+        single_file = formation.along_path and all(abs(o[1]) < 1e-9 for o in formation.offsets)
+        slot_of = assign_single_file(positions, slot_world, leader_pose.theta) if single_file \
+            else assign_slots(positions, slot_world, leader_index=0)
         robot_in_slot = {slot_of[i]: r for i, r in enumerate(order)}
         slots = {r: (float(formation.offsets[slot_of[i]][0]), float(formation.offsets[slot_of[i]][1]))
                  for i, r in enumerate(order)}
@@ -351,7 +381,8 @@ class FleetCoordinator(object):
         for i, r in enumerate(order):
             parent = formation.parents[slot_of[i]]
             follows[r] = robot_in_slot[parent] if parent >= 0 else ""
-        self.assignment = Assignment(self.leader, self.formation, self.spacing, slots, follows)
+        self.assignment = Assignment(self.leader, self.formation, self.spacing, slots, follows,
+                                     formation.along_path)
         self._stable_since = None
         return [("assignment",)]
 
@@ -363,11 +394,11 @@ class FleetCoordinator(object):
         robots = [a.leader] + [r for r in a.slots if r != a.leader and r in poses]
         if len(robots) < 2:
             return None
-        leader = poses[a.leader]
+        slots = self.slot_poses(poses)
         actual = np.array([[poses[r].x, poses[r].y] for r in robots])
-        desired = np.array([_apply(leader, a.slots[r]) for r in robots])
+        desired = np.array([[slots[r].x, slots[r].y] for r in robots])
         headings = [poses[r].theta for r in robots]
-        return shape_errors(actual, desired, headings=headings, leader_heading=leader.theta)
+        return shape_errors(actual, desired, headings=headings, desired_headings=[slots[r].theta for r in robots])
 
     def _stable(self, now):
         """The shape is within the FORMING tolerances and has been for stable_time."""
@@ -383,18 +414,25 @@ class FleetCoordinator(object):
             self._stable_since = now
         return now - self._stable_since >= self.config.stable_time
 
-    def slot_errors(self, poses):
-        """{follower: (distance to its slot [m], heading error [rad])} for the debug print."""
+    def slot_poses(self, poses):
+        """{robot: Pose2D in the map} of every slot of the assignment, the leader's included: where
+        each robot belongs and which way it should face ({} without an assignment or leader pose)."""
         a = self.assignment
         if a is None or a.leader not in poses:
             return {}
-        leader = poses[a.leader]
+        trail = self._trail if a.along_path else None
+        return {r: slot_pose(poses[a.leader], offset, trail) for r, offset in a.slots.items()}
+
+    def slot_errors(self, poses):
+        """{follower: (distance to its slot [m], heading error to its slot's heading [rad])}."""
+        a = self.assignment
+        slots = self.slot_poses(poses)
         result = {}
-        for r, offset in sorted(a.slots.items()):
+        for r, slot in sorted(slots.items()):
             if r == a.leader or r not in poses:
                 continue
-            x, y = _apply(leader, offset)
-            result[r] = (math.hypot(poses[r].x - x, poses[r].y - y), normalize_angle(poses[r].theta - leader.theta))
+            result[r] = (math.hypot(poses[r].x - slot.x, poses[r].y - slot.y),
+                         normalize_angle(poses[r].theta - slot.theta))
         return result
 
     def _worst_follower(self, poses):
@@ -410,6 +448,7 @@ class FleetCoordinator(object):
         self.phase = phase
         self._phase_since = now
         self._regroup_since = None
+        self._switch_waits = False
         self.reason = reason
 
 

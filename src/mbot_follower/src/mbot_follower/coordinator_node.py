@@ -132,10 +132,10 @@ class CoordinatorNode(object):
 
     def _set_goal(self, target, formation="", spacing=0.0):
         with self.lock:
-            now = rospy.Time.now().to_sec()
-            ok, text, actions = self.core.set_goal(target, now, dict(self.poses), formation, spacing)
-            self._run(actions)
-            self._publish_status(force=True)
+            now = rospy.Time.now()
+            ok, text, actions = self.core.set_goal(target, now.to_sec(), dict(self.poses), formation, spacing)
+            self._run(actions, now)
+            self._publish_status(force=True, stamp=now)
         return ok, text
 
     def _on_formation(self, msg):
@@ -152,10 +152,10 @@ class CoordinatorNode(object):
         if not (spacing == 0.0 or (math.isfinite(spacing) and spacing > 0.0)):
             return False, "spacing %r: expected a number > 0 [m] (0 keeps the current one)" % spacing
         with self.lock:
-            ok, text, actions = self.core.set_formation(name.strip(), rospy.Time.now().to_sec(), dict(self.poses),
-                                                        spacing)
-            self._run(actions)
-            self._publish_status(force=True)
+            now = rospy.Time.now()
+            ok, text, actions = self.core.set_formation(name.strip(), now.to_sec(), dict(self.poses), spacing)
+            self._run(actions, now)
+            self._publish_status(force=True, stamp=now)
         return ok, text
 
     def _execute(self, goal):
@@ -276,8 +276,10 @@ class CoordinatorNode(object):
                 rospy.loginfo("coordinator: %s's navigation: %s", leader, nav or "no goal")
                 self._last_nav = nav
             actions = self.core.update(now, poses, last_heard, nav, obstacle, excused)
-            self._run(actions)
-            self._publish_status()
+            # the assignment and the status of one decision carry its time: a metrics sample
+            # between two stamps would see the new slots under the old state
+            self._run(actions, now_ros)
+            self._publish_status(stamp=now_ros)
             self.marker_pub.publish(markers.fleet_markers(self.core, poses, now_ros))
             if self.params["debug_mode"] and (self._last_debug is None or now - self._last_debug >= 1.0):
                 self._last_debug = now
@@ -330,12 +332,12 @@ class CoordinatorNode(object):
                     pending.remove(robot)
             time.sleep(0.1)
 
-    def _run(self, actions):
+    def _run(self, actions, stamp=None):
         from mbot_navigation.move_base_client import make_goal
 
         for action in actions:
             if action[0] == "assignment":
-                self.assignment_pub.publish(assignment_to_msg(self.core.assignment, rospy.Time.now()))
+                self.assignment_pub.publish(assignment_to_msg(self.core.assignment, stamp or rospy.Time.now()))
             elif action[0] == "goal":
                 _, robot, target = action
                 if self._nav_robot is not None and self._nav_robot != robot:
@@ -355,10 +357,10 @@ class CoordinatorNode(object):
             client.cancel_all_goals()
             self._nav_robot = None
 
-    def _publish_status(self, force=False):
+    def _publish_status(self, force=False, stamp=None):
         c = self.core
         key = (c.state(), c.reason, c.leader, c.formation, tuple(c.members), tuple(c.lost), c.paused)
-        now = rospy.Time.now()
+        now = stamp or rospy.Time.now()
         if not force and key == self._published_state and self._last_status is not None \
                 and (now - self._last_status).to_sec() < 0.5:
             return

@@ -12,8 +12,9 @@ from mbot_common.geometry import Pose2D, yaw_of
 
 #: The fleet's slot assignment as plain data.
 #: leader: robot name; formation: name; spacing [m]; slots: {robot: (x, y)} in the leader's frame
-#: (the leader's own slot is (0, 0)); follows: {robot: the robot whose pose it tracks}.
-Assignment = namedtuple("Assignment", "leader formation spacing slots follows")
+#: (the leader's own slot is (0, 0)); follows: {robot: the robot whose pose it tracks};
+#: along_path: the slots behind the leader lie on its path (trail.path_slot), not rigid.
+Assignment = namedtuple("Assignment", "leader formation spacing slots follows along_path", defaults=(False,))
 
 
 class StalePose(Exception):
@@ -24,7 +25,7 @@ def assignment_from_msg(msg):
     """mbot_msgs/FleetAssignment -> Assignment."""
     slots = {s.robot: (s.offset.x, s.offset.y) for s in msg.slots}
     follows = {s.robot: s.follows for s in msg.slots}
-    return Assignment(msg.leader, msg.formation, msg.spacing, slots, follows)
+    return Assignment(msg.leader, msg.formation, msg.spacing, slots, follows, msg.along_path)
 
 
 def assignment_to_msg(assignment, stamp):
@@ -37,6 +38,7 @@ def assignment_to_msg(assignment, stamp):
     msg.leader = assignment.leader
     msg.formation = assignment.formation
     msg.spacing = assignment.spacing
+    msg.along_path = bool(assignment.along_path)
     order = [assignment.leader] + sorted(r for r in assignment.slots if r != assignment.leader)
     for robot in order:
         slot = SlotAssignment()

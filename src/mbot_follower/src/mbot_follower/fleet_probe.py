@@ -3,6 +3,8 @@ robot's ground truth from the simulator, the coordinator's status and assignment
 the controllers' modes, sends targets and switches on the public topics, and waits for
 conditions in sim time (with a wall-clock bound, since at real_time_factor 0 sim time may race or
 stall). What it measures comes from the simulator, not from what the coordinator says of itself.
+The slots of a formation along the path (a column) are placed on the leader's ground-truth path
+since the assignment (trail.path_slot), like the coordinator and the metrics place them.
 """
 import math
 import threading
@@ -14,22 +16,37 @@ from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus, FollowerState
 from nav_msgs.msg import Odometry
 from std_msgs.msg import String
 
-from mbot_common.geometry import Pose2D, compose, yaw_of
+from mbot_common.geometry import Pose2D, yaw_of
+from mbot_follower.trail import Trail, slot_pose
 
 WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
+
+
+class SampledAssignment(object):
+    """An assignment message as it was at one sample, with its slots placed in the map then
+    (`slot_poses`: {robot: Pose2D}); reads like the message (leader, formation, slots, ...)."""
+
+    def __init__(self, msg, slot_poses):
+        self.msg = msg
+        self.slot_poses = slot_poses
+
+    def __getattr__(self, name):
+        return getattr(self.msg, name)
 
 
 class FleetProbe(object):
     """Records the fleet: ground truth of every robot, status, assignment, contacts."""
 
     def __init__(self, robots):
-        self.lock = threading.Lock()
+        self.lock = threading.RLock()   # slot_errors() takes it, also inside describe()
         self.robots = robots
         self.truth = {}        # robot -> (t, Pose2D, speed)
         self.samples = []      # (t, state, {robot: Pose2D}, {robot: speed}, assignment)
         self.status = None
         self.states = []       # (t, state, reason)
         self.assignment = None
+        self.trail = Trail()   # the leader's ground truth since the assignment (path slots)
+        self._trail_pending = False
         self.contacts = []
         for r in robots:
             rospy.Subscriber("/%s/base_pose_ground_truth" % r, Odometry, self._on_truth, callback_args=r, queue_size=5)
@@ -52,8 +69,13 @@ class FleetProbe(object):
         p = msg.pose.pose
         v = msg.twist.twist.linear
         with self.lock:
-            self.truth[robot] = (msg.header.stamp.to_sec(), Pose2D(p.position.x, p.position.y, yaw_of(p.orientation)),
-                                 math.hypot(v.x, v.y))
+            pose = Pose2D(p.position.x, p.position.y, yaw_of(p.orientation))
+            self.truth[robot] = (msg.header.stamp.to_sec(), pose, math.hypot(v.x, v.y))
+            if self.assignment is not None and robot == self.assignment.leader:
+                if self._trail_pending:
+                    self.trail.start(pose.x, pose.y, pose.theta)
+                    self._trail_pending = False
+                self.trail.add(pose.x, pose.y)
 
     def _on_status(self, msg):
         with self.lock:
@@ -64,6 +86,7 @@ class FleetProbe(object):
     def _on_assignment(self, msg):
         with self.lock:
             self.assignment = msg
+            self._trail_pending = True   # the path starts at the leader's next pose
 
     def _on_contact(self, msg):
         with self.lock:
@@ -75,22 +98,36 @@ class FleetProbe(object):
                 return
             poses = {r: v[1] for r, v in self.truth.items()}
             speeds = {r: v[2] for r, v in self.truth.items()}
-            self.samples.append((rospy.get_time(), self.status.state, poses, speeds, self.assignment))
+            a = self.assignment
+            if a is not None:
+                a = SampledAssignment(a, self._slot_poses(poses, a))
+            self.samples.append((rospy.get_time(), self.status.state, poses, speeds, a))
 
     # --- measures -----------------------------------------------------------------------------
 
-    @staticmethod
-    def slot_errors(poses, assignment):
-        """{follower: distance to its slot} from ground truth poses and an assignment message."""
+    def _slot_poses(self, poses, assignment):
+        """{robot: Pose2D} of the assignment's slots for the leader's pose in `poses` ({}: none);
+        a path slot on the leader's path as recorded now."""
         if assignment is None or assignment.leader not in poses:
             return {}
-        leader = poses[assignment.leader]
+        trail = self.trail if assignment.along_path and not self._trail_pending and len(self.trail) else None
+        return {s.robot: slot_pose(poses[assignment.leader], (s.offset.x, s.offset.y), trail)
+                for s in assignment.slots}
+
+    def slot_errors(self, poses, assignment):
+        """{follower: distance to its slot} from ground truth poses and an assignment: a sample's
+        (its slots as placed then) or the message (its slots placed now)."""
+        if assignment is None or assignment.leader not in poses:
+            return {}
+        slots = getattr(assignment, "slot_poses", None)
+        if slots is None:
+            with self.lock:
+                slots = self._slot_poses(poses, assignment)
         errors = {}
         for s in assignment.slots:
-            if s.robot == assignment.leader or s.robot not in poses:
+            if s.robot == assignment.leader or s.robot not in poses or s.robot not in slots:
                 continue
-            slot = compose(leader, Pose2D(s.offset.x, s.offset.y, 0.0))
-            errors[s.robot] = math.hypot(poses[s.robot].x - slot.x, poses[s.robot].y - slot.y)
+            errors[s.robot] = math.hypot(poses[s.robot].x - slots[s.robot].x, poses[s.robot].y - slots[s.robot].y)
         return errors
 
     def state(self):

@@ -8,11 +8,16 @@ Every control period (sim time) it
    polling up to ``~pose_wait`` of wall time for a transform at most ``~max_pose_age`` old; a
    failed or stale lookup skips the control law and holds the robot still: it never acts on
    old data. Lookups and failures are counted and published;
-3. picks its target: its slot from ``/fleet/assignment``, or, when the slot or the straight way
-   to it is blocked (a wall, its inflation, something the laser sees), a point on the leader's
-   recent path (the trail) ``~trail_lookahead`` ahead of where the follower is on it, but no
-   nearer the leader than the slot is: a path the leader drove is free, also around corners and
-   through doors, and the follower rejoins its slot once the way is clear again;
+3. picks its target: its slot from ``/fleet/assignment`` (for a formation along the path, a
+   column, the point of the leader's path its slot's distance behind the leader, from the
+   leader's map positions recorded since the assignment: trail.path_slot), or, when the slot
+   or the straight way to it is blocked (a wall, its inflation, something the laser sees), a
+   point on the leader's recent path (the trail) ``~trail_lookahead`` ahead of where the
+   follower is on it, but no nearer the leader than the slot is: a path the leader drove is
+   free, also around corners and through doors, and the follower rejoins its slot once the way
+   is clear again. A path shorter than the slot's distance from the leader (it has just set
+   off) has no such point: the follower keeps to its slot (its safety layer stops it short of
+   what blocks it) rather than drive ahead of the robots that belong in front of it;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
@@ -29,12 +34,12 @@ import time
 
 import rospy
 
-from mbot_common.geometry import Pose2D, Twist2D, compose, relative
+from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, energy_rate,
                                         make_control_law, safety_filter)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
 from mbot_follower.free_space import FreeSpace
-from mbot_follower.trail import Trail
+from mbot_follower.trail import Trail, path_pose, path_slot
 
 #: Private parameters of the node itself (the control law's are ControllerConfig's fields).
 NODE_PARAMS = {
@@ -47,6 +52,7 @@ NODE_PARAMS = {
     "scan_clearance": 0.35,   # a laser point closer than this to the way to the slot blocks it [m]
     "scan_horizon": 2.0,      # how far along the way to the slot the laser check looks [m]
     "trail_lookahead": 0.6,   # on the trail, drive to the point this far ahead on it [m]
+    "path_turn_window": 0.2,  # a path slot turns as the path does over this much path ahead of it [m]
 }
 HOLD_STATES = ("IDLE", "ABORTED")
 
@@ -81,7 +87,11 @@ class FollowerController(object):
         self.paused = False
         self.scan = None
         self.free_space = None
-        self.trail = Trail()
+        self.trail = Trail()               # the leader's path, for a blocked slot (trail mode)
+        self.path = Trail()                # the leader's path since the assignment (path slots)
+        self._path_pending = False         # start self.path at the leader's next pose
+        self._leader_map = None            # the leader's newest map pose
+        self._reference = None
         self.leader_twist = Twist2D(0.0, 0.0, 0.0)
         self._leader_odom_sub = None
         self._leader_sub_name = None
@@ -132,14 +142,21 @@ class FollowerController(object):
     def _on_assignment(self, msg):
         self.assignment = assignment_from_msg(msg)
         reference = self.assignment.follows.get(self.robot) or self.assignment.leader
-        if self._leader_sub_name != reference:
+        if self._reference != reference:
+            self._reference = reference
+            self.trail.clear()
+        self._path_pending = True
+        self._leader_map = None
+        # The twist that moves the slot: the reference robot's for a rigid slot, the leader's
+        # for a path slot (it moves along the path as fast as the leader drives).
+        source = self.assignment.leader if self.assignment.along_path else reference
+        if self._leader_sub_name != source:
             if self._leader_odom_sub is not None:
                 self._leader_odom_sub.unregister()
-            self._leader_sub_name = reference
+            self._leader_sub_name = source
             self.leader_twist = Twist2D(0.0, 0.0, 0.0)
-            self.trail.clear()
             self._leader_odom_sub = rospy.Subscriber(
-                "/%s/odom" % reference, self._msg["Odometry"], self._on_leader_odom, queue_size=1)
+                "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, queue_size=1)
 
     def _on_status(self, msg):
         self.fleet_state = msg.state
@@ -202,10 +219,12 @@ class FollowerController(object):
 
         started += time.time() - lookup_started  # waiting for tf is not computing: not in cycle_time
         self._record_trail(a, reference, ref_map, now)
-        slot = self._slot_relative_to(a, reference)
-        target, mode = self._target(slot, pose, ref_map, math.hypot(*a.slots[self.robot]))
-        neighbours = self._neighbours(a, now) if self.params["controller"] == "consensus" else []
-        twist = self.leader_twist if mode == "slot" else Twist2D(self.leader_twist.vx, 0.0, 0.0)
+        frame, pose, slot, frame_twist = self._slot_frame(a, reference, pose, ref_map)
+        target, mode = self._target(slot, pose, frame, math.hypot(*a.slots[self.robot]))
+        neighbours = []
+        if self.params["controller"] == "consensus":
+            neighbours = self._neighbours(a, now) if frame is ref_map else self._path_neighbours(a, now, frame)
+        twist = frame_twist if mode == "slot" else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
         if self.scan is not None:
@@ -224,9 +243,9 @@ class FollowerController(object):
         self._publish_state(now, mode, started, stamp, err, -pose.theta, cmd)
 
     def _record_trail(self, a, reference, ref_map, now):
-        """Add the leader's map position to its trail. In a chain the leader is not the robot
-        this follower tracks: a stale leader pose only skips this point of the trail (it must
-        not hold the robot still)."""
+        """Add the leader's map position to its trails. In a chain the leader is not the robot
+        this follower tracks: a stale leader pose only skips this point of the trails (it must
+        not hold the robot still). The path of a new assignment starts at the leader's pose."""
         leader_map = ref_map
         if reference != a.leader:
             try:
@@ -235,6 +254,31 @@ class FollowerController(object):
             except StalePose:
                 return
         self.trail.add(leader_map.x, leader_map.y)
+        if self._path_pending:
+            self.path.start(leader_map.x, leader_map.y, leader_map.theta)
+            self._path_pending = False
+        self.path.add(leader_map.x, leader_map.y)
+        self._leader_map = leader_map
+
+    def _slot_frame(self, a, reference, pose, ref_map):
+        """(frame in the map, the robot's pose in it, its slot (x, y) in it, the frame's twist)
+        for the control law, which wants a slot that stands still in a moving frame.
+
+        A rigid slot stands still in the reference robot's frame, which moves with that robot's
+        twist. A path slot (along_path, behind the leader) stands still in its own frame, the
+        slot's pose on the leader's path: that frame moves forward as fast as the leader drives
+        and turns as the path turns ahead of it (not as the leader turns)."""
+        offset = a.slots[self.robot]
+        if not a.along_path or offset[0] >= 0.0 or self._leader_map is None or self._path_pending:
+            return ref_map, pose, self._slot_relative_to(a, reference), self.leader_twist
+        leader, distance = self._leader_map, -offset[0]
+        slot = path_slot(leader, self.path, offset)
+        speed = math.hypot(self.leader_twist.vx, self.leader_twist.vy)
+        window = min(self.params["path_turn_window"], distance)
+        turn = normalize_angle(path_pose(leader, self.path, distance - window).theta
+                               - path_pose(leader, self.path, distance).theta)
+        twist = Twist2D(speed, 0.0, speed * turn / window if window > 0.0 else 0.0)
+        return slot, relative(slot, compose(ref_map, pose)), (0.0, 0.0), twist
 
     def _rank(self, a, slot):
         """How many follower slots lie farther from the leader than this robot's (GiveWay)."""
@@ -261,10 +305,12 @@ class FollowerController(object):
                 me_map.x, me_map.y, slot_map.x, slot_map.y)
         if not blocked:
             blocked = self._scan_blocks(pose, slot)
-        if not blocked or len(self.trail) < 2:
+        point = None
+        if blocked and len(self.trail):
+            point = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
+        if point is None:  # not blocked, or the leader's path does not reach back to the slot yet
             return slot, "slot"
-        tx, ty = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
-        t = relative(ref_map, Pose2D(tx, ty, 0.0))
+        t = relative(ref_map, Pose2D(point[0], point[1], 0.0))
         return (t.x, t.y), "trail"
 
     def _scan_blocks(self, pose, slot):
@@ -292,6 +338,20 @@ class FollowerController(object):
             if 0.0 <= along <= horizon and abs(-px * uy + py * ux) < clearance:
                 return True
         return False
+
+    def _path_neighbours(self, a, now, frame):
+        """The other followers' poses and path slots in `frame` (consensus along the path)."""
+        result = []
+        for robot, offset in a.slots.items():
+            if robot in (self.robot, a.leader):
+                continue
+            try:
+                pose, _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % robot, now, self.params["max_pose_age"])
+            except StalePose:
+                continue
+            slot = relative(frame, path_slot(self._leader_map, self.path, offset))
+            result.append((relative(frame, pose), (slot.x, slot.y)))
+        return result
 
     def _neighbours(self, a, now):
         """The other followers' poses in the leader's frame with their slots (for consensus)."""

@@ -37,6 +37,12 @@ numbers are slot indices. Followers are numbered from the leader back, left befo
                                       5   6                           5
                                         7       (n = 8)                       (n = 6)
 
+Along the path: the `column` drives along the leader's path. Its slots are not rigid points of
+the leader frame but the points of the leader's path that many metres behind it (a slot (x, y)
+with x < 0: -x metres of path back, y to the left of the path there; trail.path_slot), so in a
+corridor that turns the followers stay in the corridor instead of swinging into its walls. The
+other shapes are rigid. A custom formation drives along the path with `along_path: true`.
+
 Not symmetric about the leader's x axis: the rectangle (leader at a corner), the line and the
 wedge with an even n, and a triangle whose last row has an odd count and no middle place
 (n = 7, 9): one side has a robot more, the left one. At most MAX_ROBOTS robots.
@@ -48,6 +54,7 @@ Custom formations come from YAML files (FormationLibrary, format in the package 
       slots: [[0, 0], [-1, 0.5], [-1, -0.5], [-2, 0]]   # [x, y] in units of spacing
       topology: chain            # star (default) or chain
       parents: [-1, 0, 0, 1]     # optional explicit who-follows-whom (overrides topology)
+      along_path: false          # optional: true = slots behind the leader follow its path
 
 Pure numpy, no ROS.
 """
@@ -63,6 +70,7 @@ TOPOLOGIES = ("star", "chain")
 MAX_ROBOTS = 20          # more is a mistake for this fleet, not a formation
 MIN_SLOT_DISTANCE = 0.5  # custom slots must be at least this far apart [spacing]
 
+ALONG_PATH = ("column",)  # the built-in formations whose slots follow the leader's path
 _MIN_ROBOTS = {"line": 2, "column": 2, "triangle": 3, "wedge": 2, "rectangle": 4,
                "diamond": 4, "circle": 3}
 
@@ -72,8 +80,9 @@ class FormationError(ValueError):
 
 
 #: name; offsets: numpy (n, 2) slots in the leader frame [m], row 0 = the leader at (0, 0);
-#: parents: tuple, parents[i] = the slot that slot i follows (-1 for the leader); spacing [m].
-Formation = namedtuple("Formation", "name offsets parents spacing")
+#: parents: tuple, parents[i] = the slot that slot i follows (-1 for the leader); spacing [m];
+#: along_path: True when the slots behind the leader lie on its path (module docstring).
+Formation = namedtuple("Formation", "name offsets parents spacing along_path", defaults=(False,))
 
 
 # ------------------------------------------------------------------ the shapes (spacing 1)
@@ -265,12 +274,13 @@ def make_formation(name, n, spacing, topology="star", library=None):
     offsets = np.array(_SHAPES[name](n), dtype=float) * spacing
     offsets[offsets == 0.0] = 0.0   # no -0.0 in printouts
     parents = star_parents(n) if topology == "star" else chain_parents(offsets)
-    return Formation(name, offsets, parents, spacing)
+    return Formation(name, offsets, parents, spacing, name in ALONG_PATH)
 
 
 def world_slots(formation, leader_pose):
-    """The slots of `formation` in the world: (n, 2) [m], for a leader at leader_pose
-    (x, y, theta)."""
+    """The rigid slots of `formation` in the world: (n, 2) [m], for a leader at leader_pose
+    (x, y, theta). (Where a formation along the path wants its slots depends on the leader's
+    path as well: trail.path_slot.)"""
     x, y, theta = leader_pose
     c, s = math.cos(theta), math.sin(theta)
     rotation = np.array([[c, -s], [s, c]])
@@ -279,7 +289,7 @@ def world_slots(formation, leader_pose):
 
 # ------------------------------------------------------------------ custom formations
 
-_Custom = namedtuple("_Custom", "slots topology parents path")
+_Custom = namedtuple("_Custom", "slots topology parents along_path path")
 
 
 class FormationLibrary(object):
@@ -357,7 +367,8 @@ class FormationLibrary(object):
             if problem:
                 r.fail("parents", problem)
             parents = tuple(parents)
-        return _Custom(np.array(slots), topology, parents, path)
+        along_path = r.optional("along_path", bool, False)
+        return _Custom(np.array(slots), topology, parents, along_path, path)
 
     def make(self, name, n, spacing, topology=None):
         """The Formation `name` for n robots `spacing` [m] apart (built-in names work too).
@@ -384,4 +395,4 @@ class FormationLibrary(object):
             parents = chain_parents(offsets)
         else:
             parents = star_parents(n)
-        return Formation(name, offsets, parents, spacing)
+        return Formation(name, offsets, parents, spacing, custom.along_path)

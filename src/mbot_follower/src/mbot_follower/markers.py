@@ -37,10 +37,11 @@ def fleet_markers(core, poses, stamp):
     if a is None or leader is None:
         return array
     errors = core.slot_errors(poses)
+    slots = core.slot_poses(poses)   # on the leader's path for a column
     links = _marker("links", 0, Marker.LINE_LIST, stamp, LINK_COLOR)
     links.scale.x = 0.04
-    for i, (robot, offset) in enumerate(sorted(a.slots.items())):
-        slot = compose(leader, Pose2D(offset[0], offset[1], 0.0))
+    for i, robot in enumerate(sorted(a.slots)):
+        slot = slots[robot]
         if robot != a.leader:
             disc = _marker("slots", i, Marker.CYLINDER, stamp, SLOT_COLOR)
             disc.pose.position.x, disc.pose.position.y = slot.x, slot.y

@@ -14,8 +14,11 @@ into the same Run, so a report computes the same summary offline. Nothing here k
 
 What the numbers mean (all times sim time unless marked wall):
   slot error        distance of a follower's ground-truth position from its slot, the slot being
-                    leader pose (+) offset of the current assignment. A lost robot (in the
-                    status' `lost`) is excluded while lost; so is a robot without a fresh pose.
+                    leader pose (+) offset of the current assignment; for a formation along the
+                    path (a column) the slot on the leader's ground-truth path since the
+                    assignment (trail.path_slot), and the heading errors are to each slot's
+                    heading. A lost robot (in the status' `lost`) is excluded while lost; so is
+                    a robot without a fresh pose.
   fit error         the same after the best rigid fit (rotation + translation) of the desired
                     shape onto the actual positions (shape.rigid_fit): the shape alone.
   slot free         whether a follower's slot keeps slot_clearance to the walls of the map (1/0;
@@ -25,7 +28,10 @@ What the numbers mean (all times sim time unless marked wall):
   steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED;
                     while navigating, a follower's sample counts once its slot has been free
                     for free_hold (the time to get back from the trail). slot_blocked_share
-                    says how much of the navigating time the slots were in walls.
+                    says how much of the navigating time the slots were in walls. A follower
+                    whose controller has gone silent for controller_silence (killed, before
+                    the coordinator declares it lost) does not count: that error is the loss
+                    detection time, measured by the recovery figures.
   leader lateral    distance of the leader from the polyline of its global plan (the newest one not
                     later than the leader's pose; a new goal, FORMING, forgets the old plans); the
                     summary counts it while the leader follows the plan (NAVIGATING, DEGRADED).
@@ -53,6 +59,7 @@ What the numbers mean (all times sim time unless marked wall):
 Offline: `/usr/bin/python3 -m mbot_follower.metrics OUTPUT_DIR` prints the summary of a run.
 """
 import argparse
+import bisect
 import csv
 import json
 import math
@@ -62,8 +69,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from mbot_common.geometry import transform_point
 from mbot_follower.shape import ShapeErrors, rigid_fit, shape_errors
+from mbot_follower.trail import Trail, slot_pose
 
 NAN = float("nan")
 PLAN_STATES = ("NAVIGATING", "DEGRADED")   # the leader follows its global plan
@@ -81,7 +88,7 @@ Sample = namedtuple("Sample", "t state leader formation lost slot_rms slot_max f
                               "edge_max heading_max leader_lateral min_clearance clearance_pair robots")
 
 #: Something that happened at t [s]. kind / name / detail:
-#:   state / new state / reason        assignment / formation / "leader L spacing S m slots ..."
+#:   state / new state / reason        assignment / formation / "leader L spacing S m [along_path] slots ..."
 #:   switch / new formation / old one  loss, rejoin / robot / ""
 #:   contact / body_a / body_b, at x, y [m] (NaN for the other kinds)
 Event = namedtuple("Event", "t kind name detail x y")
@@ -96,7 +103,7 @@ class MetricsConfig(object):
 
     def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
                  robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0,
-                 slot_clearance=0.25, free_hold=3.0):
+                 slot_clearance=0.25, free_hold=3.0, controller_silence=0.5):
         self.rate = rate                      # samples per sim second [Hz]
         self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
@@ -108,6 +115,7 @@ class MetricsConfig(object):
         self.hold_back = hold_back            # a sample waits this long for a late robot's poses [s]
         self.slot_clearance = slot_clearance  # a slot closer than this to a wall is not free [m]
         self.free_hold = free_hold            # a slot free this long counts in the steady RMS [s]
+        self.controller_silence = controller_silence  # a controller unheard this long is gone [s]
         self.check()
 
     def check(self):
@@ -115,7 +123,7 @@ class MetricsConfig(object):
         limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
                   ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True),
-                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True)]
+                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True), ("controller_silence", 0.0, False)]
         for key, low, low_ok in limits:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
@@ -184,6 +192,10 @@ class MetricsCollector(object):
         self._assignments = []
         self._statuses = []
         self._next_tick = None   # the next sample is at _next_tick / rate [s]
+        # The leader's ground-truth path at the sample times since the assignment in force
+        # (_trail_of), for the slots of a formation along the path.
+        self._trail = Trail()
+        self._trail_of = None
 
     def _know(self, robot):
         if robot not in self.distance:
@@ -246,8 +258,9 @@ class MetricsCollector(object):
             self._know(robot)
         slots = " ".join("%s(%g,%g)" % (r, assignment.slots[r][0], assignment.slots[r][1])
                          for r in sorted(assignment.slots))
-        self.run.events.append(Event(t, "assignment", assignment.formation, "leader %s spacing %g m slots %s"
-                                     % (assignment.leader, assignment.spacing, slots), NAN, NAN))
+        path = " along_path" if getattr(assignment, "along_path", False) else ""
+        self.run.events.append(Event(t, "assignment", assignment.formation, "leader %s spacing %g m%s slots %s"
+                                     % (assignment.leader, assignment.spacing, path, slots), NAN, NAN))
         if old is not None and old.formation != assignment.formation:
             self.run.events.append(Event(t, "switch", assignment.formation, old.formation, NAN, NAN))
 
@@ -317,7 +330,7 @@ class MetricsCollector(object):
         at_t = {r: p for r, p in at_t.items() if p is not None and t - p[0] <= self.config.stale_after}
         fresh = {r: p[1:4] for r, p in at_t.items()}
         entry = self._in_force(self._assignments, t)
-        a = entry[1] if entry is not None else None
+        a, entry_t = (entry[1], entry[0]) if entry is not None else (None, None)
         entry = self._in_force(self._statuses, t)
         state, lost = (entry[1], entry[2]) if entry is not None else ("", ())
         slot_error, fit_error, slot_free = {}, {}, {}
@@ -326,12 +339,16 @@ class MetricsCollector(object):
         leader = a.leader if a is not None else ""
         if a is not None and leader in fresh and leader not in lost:
             lx, ly, lth = fresh[leader]
+            self._follow_leader(a, entry_t, leader, (lx, ly, lth))
+            trail = self._trail if getattr(a, "along_path", False) else None
             followers = sorted(r for r in a.slots if r != leader and r not in lost and r in fresh)
             if followers:
                 actual = [(lx, ly)] + [fresh[r][:2] for r in followers]
-                desired = [transform_point((lx, ly, lth), *a.slots.get(leader, (0.0, 0.0)))]
-                desired += [transform_point((lx, ly, lth), *a.slots[r]) for r in followers]
-                errors = shape_errors(actual, desired, headings=[lth] + [fresh[r][2] for r in followers])
+                slots = [slot_pose((lx, ly, lth), a.slots.get(leader, (0.0, 0.0)), trail)]
+                slots += [slot_pose((lx, ly, lth), a.slots[r], trail) for r in followers]
+                desired = [(p.x, p.y) for p in slots]
+                errors = shape_errors(actual, desired, headings=[lth] + [fresh[r][2] for r in followers],
+                                      desired_headings=[p.theta for p in slots])
                 _, _, fitted = rigid_fit(actual, desired)
                 for i, r in enumerate(followers, start=1):
                     slot_error[r] = math.hypot(actual[i][0] - desired[i][0], actual[i][1] - desired[i][1])
@@ -360,6 +377,15 @@ class MetricsCollector(object):
         return Sample(t, state, leader, a.formation if a is not None else "", lost,
                       errors.rms, errors.max, errors.fit_rms, errors.fit_max, errors.edge_max,
                       errors.heading_max, lateral, clearance, pair, robots)
+
+    def _follow_leader(self, a, since, leader, pose):
+        """Record the leader's pose on its trail; a new assignment `a` (in force since `since`)
+        starts the trail where the leader was then."""
+        if a is not self._trail_of:
+            start = self._pose_at(leader, since)
+            self._trail.start(*(start[1:4] if start is not None else pose))
+            self._trail_of = a
+        self._trail.add(pose[0], pose[1])
 
     def summary(self):
         return summarize(self.run)
@@ -484,6 +510,13 @@ def _leader_speed(before, now):
     return speed if math.isfinite(speed) else 0.0
 
 
+def _controller_silent(times, t, config):
+    """Whether a controller heard at the sorted times has been silent at t for controller_silence
+    (one never heard is not: it may not publish at all)."""
+    k = bisect.bisect_right(times, t + 1e-9)
+    return k > 0 and t - times[k - 1] >= config.controller_silence
+
+
 def summarize(run):
     """The summary of a Run: a JSON-ready dict (units in the key names, None = no data)."""
     config = run.config
@@ -508,7 +541,9 @@ def summarize(run):
         robots[r] = entry
 
     # Steady errors: ARRIVED, and NAVIGATING while the leader moves (its speed from this sample
-    # and the one before) for the followers whose slots have been free for free_hold.
+    # and the one before) for the followers whose slots have been free for free_hold and whose
+    # controllers are alive.
+    heard = {r: sorted(c.t for c in cs) for r, cs in controller.items()}
     navigating, arrived = [], []
     blocked_since = {}   # robot -> time of its slot's newest blocked sample
     moving_samples = blocked_samples = 0
@@ -516,13 +551,12 @@ def summarize(run):
         for r, rs in s.robots.items():
             if rs.slot_free == 0.0:
                 blocked_since[r] = s.t
-        followers = [rs.slot_error for rs in s.robots.values()]
+        followers = {r: rs for r, rs in s.robots.items()
+                     if math.isfinite(rs.slot_error) and not _controller_silent(heard.get(r, ()), s.t, config)}
         if s.state == "ARRIVED":
-            arrived += followers
+            arrived += [rs.slot_error for rs in followers.values()]
         elif s.state == "NAVIGATING" and i > 0 and _leader_speed(run.samples[i - 1], s) > config.moving_speed:
-            for r, rs in s.robots.items():
-                if not math.isfinite(rs.slot_error):
-                    continue
+            for r, rs in followers.items():
                 moving_samples += 1
                 if s.t - blocked_since.get(r, -math.inf) >= config.free_hold - 1e-9:
                     navigating.append(rs.slot_error)

@@ -16,7 +16,7 @@ Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~physics_step`` 0.01
 latency (the simulator applies a command at its next step), ``~recovered_rms`` 0.15 m and
 ``~recovered_hold`` 1 s (recovery after a loss), ``~robot_radius`` 0.15 m (clearance),
 ``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s, ``~hold_back`` 5 s,
-``~slot_clearance`` 0.25 m and ``~free_hold`` 3 s (see MetricsConfig).
+``~slot_clearance`` 0.25 m, ``~free_hold`` 3 s and ``~controller_silence`` 0.5 s (see MetricsConfig).
 A message without a stamp (zero) counts at the time it arrives.
 """
 import math

@@ -18,7 +18,8 @@ from mbot_common.geometry import normalize_angle
 
 #: All distances [m], angles [rad]. rms/max: followers to their slots; fit_rms/fit_max: the
 #: same after the best rigid fit of the whole shape; edge_max: largest |d_ij - d*_ij| over all
-#: pairs; heading_max: largest follower heading error to the leader's heading (0 if not given).
+#: pairs; heading_max: largest follower heading error to the leader's heading, or to each
+#: follower's own desired heading when given (0 if no headings are given).
 ShapeErrors = namedtuple("ShapeErrors", "rms max fit_rms fit_max edge_max heading_max")
 
 
@@ -60,13 +61,16 @@ def _rms_max(distances):
     return float(np.sqrt(np.mean(distances ** 2))), float(np.max(distances))
 
 
-def shape_errors(actual, desired, headings=None, leader_heading=None):
+def shape_errors(actual, desired, headings=None, leader_heading=None, desired_headings=None):
     """ShapeErrors of a formation. Row 0 is the leader, rows 1..n-1 the followers.
 
     actual: (n, 2) positions [m]; desired: (n, 2) the slots in the same frame [m];
-    headings: optional n headings [rad] of the robots (row 0 = the leader); leader_heading
-    [rad] defaults to headings[0]. The fit uses every row (the leader is part of the shape);
-    the errors count the followers only, like the plain ones.
+    headings: optional n headings [rad] of the robots (row 0 = the leader); each follower's
+    heading error is to leader_heading [rad] (default headings[0]), or, when
+    desired_headings (n headings [rad], row 0 = the leader's slot) are given, to its own slot's
+    heading (a column bent around a corner: each robot faces the path where it is). The fit uses
+    every row (the leader is part of the shape); the errors count the followers only, like the
+    plain ones.
     """
     a = _points("actual", actual)
     d = _points("desired", desired)
@@ -90,8 +94,16 @@ def shape_errors(actual, desired, headings=None, leader_heading=None):
         headings = [float(h) for h in headings]
         if len(headings) != n:
             raise ValueError("shape_errors: %d headings for %d robots" % (len(headings), n))
-        reference = headings[0] if leader_heading is None else float(leader_heading)
-        heading_max = max([abs(normalize_angle(h - reference)) for h in headings[1:]] or [0.0])
-    elif leader_heading is not None:
-        raise ValueError("shape_errors: leader_heading given without the robots' headings")
+        if desired_headings is not None:
+            if leader_heading is not None:
+                raise ValueError("shape_errors: give leader_heading or desired_headings, not both")
+            wanted = [float(h) for h in desired_headings]
+            if len(wanted) != n:
+                raise ValueError("shape_errors: %d desired_headings for %d robots" % (len(wanted), n))
+        else:
+            wanted = [headings[0] if leader_heading is None else float(leader_heading)] * n
+        heading_max = max([abs(normalize_angle(h - w)) for h, w in zip(headings[1:], wanted[1:])] or [0.0])
+    elif leader_heading is not None or desired_headings is not None:
+        raise ValueError("shape_errors: %s given without the robots' headings"
+                         % ("leader_heading" if leader_heading is not None else "desired_headings"))
     return ShapeErrors(rms, worst, fit_rms, fit_worst, edge_max, heading_max)

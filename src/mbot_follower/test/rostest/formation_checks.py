@@ -213,8 +213,9 @@ class FormationChecks(unittest.TestCase):
         answer = switch(formation="column", spacing=0.0)
         self.assertTrue(answer.success, answer.message)
         p.wait(lambda: p.assignment.formation == "column", 5.0, "the column assignment")
-        p.wait(lambda: self.formed(0.3), 60.0, "the column formed")
-        self.assertLess(p.truth[p.status.leader][1].x, -9.8, "the column must form before the corridor")
+        p.wait(lambda: self.formed(0.3, trace=True), 60.0, "the column formed")
+        self.assertLess(p.truth[p.status.leader][1].x, -9.8, "the column must form before the corridor:\n%s\n%s" % (
+            p.describe(), "\n".join("t=%.1f %s (%s)" % s for s in p.states[-10:])))
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 300.0, "ARRIVED through the corridor")
         self.assertEqual(p.state(), "ARRIVED", p.status.reason)
         self.assertTrue(client.wait_for_result(rospy.Duration(10.0)))
@@ -227,8 +228,13 @@ class FormationChecks(unittest.TestCase):
         self.leader_at(13.0, 0.0)
         self.assertNoContacts()
 
-    def formed(self, tolerance):
+    def formed(self, tolerance, trace=False):
+        """Every follower within `tolerance` of its slot (ground truth). `trace`: log where each
+        robot is, its slot error and its controller's mode (a failure shows who held up whom)."""
         errors = self.probe.slot_errors({r: v[1] for r, v in self.probe.truth.items()}, self.probe.assignment)
+        if trace:
+            rospy.loginfo_throttle(0.3, "formed? %s | %s" % (self.probe.status.reason,
+                                                             self.probe.describe().replace("\n", " |")))
         return bool(errors) and max(errors.values()) < tolerance
 
     def run_leader_loss(self):

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from mbot_follower.assignment import assign_slots, total_travel, travel_cost
+from mbot_follower.assignment import assign_single_file, assign_slots, total_travel, travel_cost
 
 
 def brute_force(positions, slots, leader):
@@ -76,3 +76,28 @@ def test_bad_input_is_named(positions, slots, leader, says):
     with pytest.raises(ValueError) as e:
         assign_slots(positions, slots, leader_index=leader)
     assert says in str(e.value)
+
+
+@pytest.mark.parametrize("nudge", [-0.01, 0.0, 0.01])
+def test_a_diamond_becomes_a_column_in_order_along_the_leader_heading(nudge):
+    """Leader at the origin facing +x, a diamond behind it: two sides mirrored at x = -1 (one
+    nudged a centimetre either way), the tail at x = -2. Column slots at x = -1, -2, -3: the
+    sides take the two nearer slots, in the order they stand behind the leader, the tail the
+    last, so nobody passes anybody."""
+    positions = [(0.0, 0.0), (-1.0 + nudge, 1.0), (-1.0, -1.0), (-2.0, 0.0)]
+    slots = [(0.0, 0.0), (-1.0, 0.0), (-2.0, 0.0), (-3.0, 0.0)]
+    slot_of = assign_single_file(positions, slots, heading=0.0)
+    assert slot_of[0] == 0 and slot_of[3] == 3
+    assert sorted(slot_of[1:3]) == [1, 2]
+    if nudge > 0:     # robot 1 stands nearer behind the leader: it goes first
+        assert slot_of[1] == 1
+    elif nudge < 0:
+        assert slot_of[2] == 1
+
+
+def test_single_file_follows_the_leader_heading_and_refuses_a_mismatch():
+    positions = [(0.0, 0.0), (0.0, -2.0), (0.0, -1.0)]        # leader facing +y, followers below
+    slots = [(0.0, 0.0), (0.0, -1.0), (0.0, -2.0)]
+    assert assign_single_file(positions, slots, heading=math.pi / 2) == [0, 2, 1]
+    with pytest.raises(ValueError, match="assign_single_file"):
+        assign_single_file(positions, slots[:2], heading=0.0)

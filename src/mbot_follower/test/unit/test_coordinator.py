@@ -294,3 +294,122 @@ def test_the_leader_left_alone_keeps_its_goal_and_the_others_rejoin():
     core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE")
     assert sorted(core.members) == sorted(ROBOTS) and core.formation == "triangle"
     assert len(core.assignment.slots) == 3
+
+
+def test_after_a_switch_on_the_move_the_leader_waits_for_excused_followers_too():
+    # changing places, followers block each other: held or on the trail, they flicker in and
+    # out of being excused, and the leader must not drive on at each flicker
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    ok, _, _ = core.set_formation("line", t, poses)
+    assert ok
+    off = dict(poses)   # still on the triangle's slots, far from the line's
+    actions = core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1"])
+    assert actions == [("cancel", "leader")] and "regrouping" in core.reason
+    for i, excused in enumerate((["follower_1", "follower_2"], [], ["follower_2"])):
+        assert core.update(t + 0.2 + 0.1 * i, off, heard(t + 0.2 + 0.1 * i), excused=excused) == []
+    t += 1.0
+    actions = core.update(t, at_slots(core, poses["leader"]), heard(t), excused=["follower_1"])
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "regrouped" in core.reason
+
+
+def test_after_the_switch_regroup_ends_excused_followers_no_longer_hold_up_the_leader():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("line", t, poses)
+    off = dict(poses)
+    core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE", excused=["follower_1", "follower_2"])
+    t += 0.1 + core.config.regroup_timeout + 0.1
+    actions = core.update(t, off, heard(t), excused=["follower_1", "follower_2"])
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "regrouping" in core.reason
+    # behind a wall for good: after the timeout's pause they are excused as before the switch
+    t += core.config.regroup_timeout + 0.1
+    assert core.update(t, off, heard(t), leader_nav="ACTIVE", excused=["follower_1", "follower_2"]) == []
+
+
+# --- a column along the leader's path --------------------------------------------------------
+
+def l_path(s):
+    """Pose on an L-shaped path at arc length s [m] from (0, 0): 1.5 m along +x, then along +y
+    (s < 0: straight on behind the start)."""
+    if s <= 1.5:
+        return Pose2D(s, 0.0, 0.0)
+    return Pose2D(1.5, s - 1.5, math.pi / 2)
+
+
+def drive_l_corner(core, end=3.0, step=0.1):
+    """The leader drives the L from arc 0 to `end`, every follower exactly on the L where a path
+    slot puts it (its slot's distance behind the leader); then the leader stands at its goal for
+    2 s. Returns (the actions of every cycle, the final poses)."""
+    behind = {r: -x for r, (x, _) in core.assignment.slots.items()}
+    t, all_actions = 10.0, []
+    for k in range(int(round(end / step)) + 20):
+        s = min(end, (k + 1) * step)
+        t += 0.1
+        poses = {r: l_path(s - d) for r, d in behind.items()}
+        all_actions += core.update(t, poses, heard(t), leader_nav="SUCCEEDED" if s >= end else "ACTIVE")
+    return all_actions, poses
+
+
+def column_core(tmp_path, along_path):
+    """A column of 3 spacing 1 m formed at the start of the L and navigating; along_path False:
+    the same slots as a rigid custom formation."""
+    name = "column"
+    library = None
+    if not along_path:
+        from mbot_follower.formations import FormationLibrary
+        path = tmp_path / "rigid.yaml"
+        path.write_text("formations:\n  rigid_column:\n    slots: [[0, 0], [-1, 0], [-2, 0]]\n")
+        library = FormationLibrary()
+        library.load_file(str(path))
+        name = "rigid_column"
+    core = FleetCoordinator(ROBOTS, "leader", name, 1.0, CoordinatorConfig(), library=library)
+    poses = {"leader": l_path(0.0), "follower_1": l_path(-1.0), "follower_2": l_path(-2.0)}
+    assert core.set_goal(Pose2D(1.5, 1.5, math.pi / 2), 0.0, poses)[0]
+    assert core.assignment.along_path == along_path
+    for k in range(10):
+        core.update(0.1 * (k + 1), poses, heard(0.1 * (k + 1)))
+    assert core.phase == NAVIGATING
+    return core
+
+
+def test_a_column_bent_around_a_corner_on_its_path_slots_is_formed(tmp_path):
+    core = column_core(tmp_path, along_path=True)
+    actions, poses = drive_l_corner(core, end=3.0)
+    # the leader at (1.5, 1.5) facing +y; the last follower 2 m of path back, still on the x leg
+    assert poses["leader"] == Pose2D(1.5, 1.5, math.pi / 2)
+    assert poses["follower_2"] == Pose2D(1.0, 0.0, 0.0)
+    slots = core.slot_poses(poses)
+    for r in ("follower_1", "follower_2"):
+        assert slots[r] == pytest.approx(poses[r], abs=1e-9)
+        distance, heading = core.slot_errors(poses)[r]
+        assert distance < 1e-9 and abs(heading) < 1e-9
+    assert not any(a[0] == "cancel" for a in actions)          # never regrouped
+    assert core.errors.edge_max < 1e-9 and core.errors.heading_max < 1e-9
+    assert core.state() == ARRIVED and "formation is stable" in core.reason
+
+
+def test_the_same_bent_column_measured_against_rigid_slots_is_not_formed(tmp_path):
+    core = column_core(tmp_path, along_path=False)
+    actions, poses = drive_l_corner(core, end=3.0)
+    errors = core.slot_errors(poses)
+    # the rigid slot 2 m behind the leader is at (1.5, -0.5): 0.71 m from the robot, 90 deg turned
+    assert errors["follower_2"][0] == pytest.approx(math.hypot(0.5, 0.5))
+    assert abs(errors["follower_2"][1]) == pytest.approx(math.pi / 2)
+    assert ("cancel", "leader") in actions                     # the leader waited on the way
+    assert core.errors.heading_max > core.config.form_heading_tolerance
+    assert core.state() == NAVIGATING                          # arrived, but not stable
+
+
+def test_a_new_assignment_starts_the_path_anew(tmp_path):
+    core = column_core(tmp_path, along_path=True)
+    _, poses = drive_l_corner(core, end=3.0)
+    ok, _, _ = core.set_formation("column", 20.0, poses, spacing=0.8)
+    assert ok
+    # right after the switch the path slots are the rigid ones: straight behind the leader
+    slots = core.slot_poses(poses)
+    leader = poses["leader"]
+    for r, (x, y) in core.assignment.slots.items():
+        rigid = compose(leader, Pose2D(x, y, 0.0))
+        assert (slots[r].x, slots[r].y) == pytest.approx((rigid.x, rigid.y), abs=1e-9)
+        assert slots[r].theta == pytest.approx(leader.theta, abs=1e-9)

@@ -197,6 +197,16 @@ def test_custom_formations_are_scaled_and_keep_their_parents():
     assert library.make("column", 3, 1.0, topology="chain").parents == (-1, 0, 1)
 
 
+def test_column_and_custom_formations_that_say_so_drive_along_the_path():
+    library = loaded_library()
+    assert library.make("tail", 3, 1.0).along_path                 # along_path: true in the file
+    assert not library.make("arrow", 4, 1.0).along_path            # not said: rigid
+    assert make_formation("column", 3, 1.0).along_path
+    assert library.make("column", 3, 1.0, topology="chain").along_path
+    for name in ("line", "triangle", "wedge", "rectangle", "diamond", "circle"):
+        assert not make_formation(name, 4, 1.0).along_path, name
+
+
 def test_custom_formation_takes_exactly_its_slot_count():
     library = loaded_library()
     with pytest.raises(FormationError) as e:
@@ -233,6 +243,7 @@ def test_a_file_loaded_twice_is_an_error_and_a_bad_file_adds_nothing():
      "parents[2] = -1: expected the index of another slot, 0 to 2 (only the leader follows nobody)"),
     ("invalid_parents_length.yaml", "formations.arrow.parents", "expected 3 entries (one per slot), got 2"),
     ("invalid_topology.yaml", "formations.arrow.topology", 'expected star or chain, got "ring"'),
+    ("invalid_along_path_type.yaml", "formations.arrow.along_path", 'expected true or false, got "yes"'),
     ("invalid_shadows_builtin.yaml", "formations.wedge", "'wedge' is a built-in formation"),
     ("invalid_top_level_key.yaml", "spacing", "unknown key"),
     ("no_such_file.yaml", None, "cannot read the file"),

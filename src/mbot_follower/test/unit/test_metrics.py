@@ -287,6 +287,36 @@ def test_steady_rms_in_navigating_while_moving_and_in_arrived():
                                     "ARRIVED": pytest.approx(1.9)}
 
 
+def test_a_follower_whose_controller_fell_silent_leaves_the_steady_rms():
+    """robot_2's controller stops at 4 s (killed) and the robot stands while the leader drives on:
+    its growing error is the time the coordinator takes to declare it lost, not the formation's
+    steady error. It counts until its controller has been silent for controller_silence."""
+    c = MetricsCollector(MetricsConfig(controller_silence=0.5))
+    c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0), "robot_2": (-2.0, 0.0)},
+                               "column"))
+
+    def at(t):
+        if near(t, 0.0):
+            c.on_status(t, "NAVIGATING", "", [])
+        for r in ("robot_1", "robot_2"):
+            if r == "robot_1" or t < 4.0 - 1e-9:
+                c.on_follower_state(r, t, t, True, 1, 0, 0.001, "track")
+
+    def poses(t):
+        lx = 0.5 * t
+        return {"robot_0": (lx, 0.0, 0.0), "robot_1": (lx - 1.0, 0.1, 0.0),
+                "robot_2": (min(lx, 2.0) - 2.0, 0.1, 0.0)}   # stands from 4 s on
+
+    drive(c, 0.0, 8.0, poses, at)
+    s = summarize(c.run)["fleet"]
+    # robot_2 counts until its controller has been silent 0.5 s: off by at most ~0.2 m then,
+    # while it ends 2 m from its slot.
+    assert s["slot_max_m"] > 1.9
+    assert s["steady_navigating_slot_rms_m"] < 0.13
+    c.run.config = MetricsConfig(controller_silence=100.0)   # never silent: all of its error counts
+    assert summarize(c.run)["fleet"]["steady_navigating_slot_rms_m"] > 0.5
+
+
 def test_clearance_contacts_and_stale_poses():
     c = MetricsCollector(MetricsConfig(robot_radius=0.15))
     c.on_pose("robot_3", 0.0, 0.0, 0.6, 0.0)   # heard once: stale after 1 s, then never counted
@@ -476,3 +506,31 @@ def test_a_run_recorded_before_slot_free_reads_as_unknown(tmp_path):
     assert all(math.isnan(rs.slot_free) for s in back.samples for rs in s.robots.values())
     assert summarize(back)["fleet"]["steady_navigating_slot_rms_m"] == \
         summarize(c.run)["fleet"]["steady_navigating_slot_rms_m"]
+
+
+def l_path(s):
+    """(x, y, theta) at arc length s [m] of an L: 1.5 m along +x from (0, 0), then along +y
+    (s < 0: straight on behind the start)."""
+    return (s, 0.0, 0.0) if s <= 1.5 else (1.5, s - 1.5, math.pi / 2)
+
+
+@pytest.mark.parametrize("along_path", [True, False])
+def test_a_column_on_its_path_slots_around_a_corner_has_no_slot_error(along_path):
+    column = {"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0), "robot_2": (-2.0, 0.0)}
+    c = MetricsCollector()
+    c.on_assignment(0.0, Assignment("robot_0", "column", 1.0, column, {r: "robot_0" for r in column},
+                                    along_path))
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    # the leader drives the L at 1 m/s; each follower exactly where the leader was 1 m / 2 m before
+    drive(c, 0.0, 3.0, lambda t: {r: l_path(t + x) for r, (x, _) in column.items()})
+    s = summarize(c.run)
+    last = c.run.samples[-1]            # t = 2.9: the leader at (1.5, 1.4), robot_2 at (0.9, 0)
+    assert last.t == pytest.approx(2.9) and last.robots["robot_2"].x == pytest.approx(0.9)
+    if along_path:
+        assert s["fleet"]["slot_max_m"] < 1e-9
+        assert s["fleet"]["steady_navigating_slot_rms_m"] < 1e-9
+        assert last.heading_max < 1e-9  # each robot faces the way of the path where it is
+    else:
+        # rigid slots swing around the corner: robot_2's is at (1.5, -0.6), 0.85 m away
+        assert last.robots["robot_2"].slot_error == pytest.approx(math.hypot(0.6, 0.6))
+        assert last.heading_max == pytest.approx(math.pi / 2)

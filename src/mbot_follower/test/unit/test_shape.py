@@ -61,6 +61,22 @@ def test_one_follower_off_by_known_amounts():
     assert e.heading_max == pytest.approx(2 * math.pi - 3.5)
 
 
+def test_heading_errors_against_each_followers_own_slot_heading():
+    # a column bent by 90 deg: the leader faces +y, the last follower is still on the +x leg
+    actual = np.array([[0.0, 0.0], [0.0, -1.0], [-1.0, -1.0]])
+    headings = [math.pi / 2, math.pi / 2 + 0.05, -0.02]
+    bent = shape_errors(actual, actual, headings=headings, desired_headings=[math.pi / 2, math.pi / 2, 0.0])
+    assert bent.heading_max == pytest.approx(0.05)
+    # against the leader's heading the last robot is 90 deg off
+    assert shape_errors(actual, actual, headings=headings).heading_max == pytest.approx(math.pi / 2 + 0.02)
+    with pytest.raises(ValueError, match="2 desired_headings for 3 robots"):
+        shape_errors(actual, actual, headings=headings, desired_headings=[0.0, 0.0])
+    with pytest.raises(ValueError, match="not both"):
+        shape_errors(actual, actual, headings=headings, leader_heading=0.0, desired_headings=[0.0] * 3)
+    with pytest.raises(ValueError, match="desired_headings given without the robots' headings"):
+        shape_errors(actual, actual, desired_headings=[0.0] * 3)
+
+
 def test_leader_only_and_bad_input():
     assert shape_errors([[1.0, 2.0]], [[0.0, 0.0]]) == ShapeErrors(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     with pytest.raises(ValueError, match="actual has 2 points, desired 3"):

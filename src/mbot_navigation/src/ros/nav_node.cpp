@@ -390,6 +390,16 @@ void NavNode::acceptGoal()
 {
   const move_base_msgs::MoveBaseGoal::ConstPtr goal = server_->acceptNewGoal();
   if (!goal) return;
+  if (server_->isPreemptRequested())
+  {
+    // Cancelled before this cycle accepted it: the preempt callback only fires for an accepted
+    // goal, so without this check the robot drove to a goal its client had already cancelled.
+    navigator_->cancel();
+    publishZero();
+    server_->setPreempted(move_base_msgs::MoveBaseResult(), "cancelled before it was accepted");
+    ROS_INFO("%s: goal cancelled before it was accepted", private_nh_.getNamespace().c_str());
+    return;
+  }
   Pose2D target;
   const std::string error = checkGoal(goal->target_pose, target);
   if (!error.empty())

@@ -93,6 +93,20 @@ class BadGoals(unittest.TestCase):
         self.assertEqual(self.client.get_state(), GoalStatus.PREEMPTED, self.client.get_goal_status_text())
         wait_until(lambda: self.speed[0] < 0.01, 2.0, "the robot to stop after the cancel")
 
+        # a cancel right behind its goal, before the node's next cycle accepted it: the goal ends
+        # without the robot driving (it drove to the cancelled goal when the node missed this)
+        start = self.track.pose
+        self.client.send_goal(make_goal(-5.0, -5.0))
+        self.client.cancel_goal()
+        self.assertTrue(self.client.wait_for_result(rospy.Duration(5.0)), "the cancelled goal did not end")
+        # LOST: the node's status came before it had the goal (the goal and the cancel travel on
+        # separate topics), and the client stops tracking it; whether the robot stays is what counts
+        self.assertIn(self.client.get_state(), (GoalStatus.PREEMPTED, GoalStatus.RECALLED, GoalStatus.LOST),
+                      "%s: %s" % (state_name(self.client.get_state()), self.client.get_goal_status_text()))
+        rospy.sleep(2.0)   # [sim s] time enough to set off, had the goal been taken
+        moved = math.hypot(self.track.pose[0] - start[0], self.track.pose[1] - start[1])
+        self.assertLess(moved, 0.05, "the robot drove %.2f m after the cancel" % moved)
+
 
 if __name__ == "__main__":
     rospy.init_node("nav_bad_goals_test")

@@ -18,6 +18,7 @@ from nav_test_tools import action_client, make_goal, state_name, wait_until
 ROBOT = "robot_0"
 NEW_MAX = 0.3      # [m/s]
 SETTLE = 0.6       # [s] sim: a control cycle, braking 0.5 -> 0.3 m/s at 1 m/s^2 (0.2 s), margin
+MIN_DRIVE = 8.0    # [s] sim: driving under the new limit that the test needs to see
 
 
 class Speeds(object):
@@ -64,11 +65,16 @@ class Reconfigure(unittest.TestCase):
         self.assertAlmostEqual(rospy.get_param("/%s/move_base/DWAPlannerROS/max_vel_x" % ROBOT), NEW_MAX)
         wait_until(lambda: rospy.Time.now().to_sec() > changed + 20.0 or client.get_state() not in
                    (GoalStatus.PENDING, GoalStatus.ACTIVE), 30.0, "20 sim s of driving")
-        self.assertEqual(client.get_state(), GoalStatus.ACTIVE, "the goal ended early: %s: %s"
-                         % (state_name(client.get_state()), client.get_goal_status_text()))
+        # On a loaded machine the robot may reach 0.4 m/s late on its way and arrive before 20 s
+        # have passed: enough when it drove MIN_DRIVE s under the new limit.
+        driven = rospy.Time.now().to_sec() - changed
+        self.assertTrue(client.get_state() == GoalStatus.ACTIVE or
+                        (client.get_state() == GoalStatus.SUCCEEDED and driven >= MIN_DRIVE),
+                        "the goal ended %.1f s after the change: %s: %s"
+                        % (driven, state_name(client.get_state()), client.get_goal_status_text()))
         after_max = speeds.max_between(changed + SETTLE, rospy.Time.now().to_sec())
-        rospy.loginfo("max speed %.3f m/s before the change, %.3f m/s from %.1f s after it", before_max, after_max,
-                      SETTLE)
+        rospy.loginfo("max speed %.3f m/s before the change, %.3f m/s from %.1f s after it (%.1f s)", before_max,
+                      after_max, SETTLE, driven)
         self.assertGreater(before_max, NEW_MAX + 0.05, "the robot never drove faster than the new limit")
         self.assertLess(after_max, NEW_MAX + 0.02, "%.3f m/s after the limit became %.2f m/s" % (after_max, NEW_MAX))
         self.assertGreater(after_max, NEW_MAX - 0.1, "the robot hardly moved after the change")

@@ -42,21 +42,31 @@ def run_goal(client, goal, timeout):
 
 
 class Track(object):
-    """A robot's ground-truth pose (/<robot>/base_pose_ground_truth) and the distance it drove."""
+    """A robot's ground-truth pose (/<robot>/base_pose_ground_truth) and the distance it drove.
+    With history=True it also keeps every sample by its stamp, to compare what a node estimated
+    for that stamp with: history[stamp in ns] = (x, y, yaw, distance driven since the start)."""
 
-    def __init__(self, robot):
+    def __init__(self, robot, history=False):
         self._lock = threading.Lock()
         self.pose = None       # (x, y, yaw)
         self.length = 0.0      # [m] since reset()
-        self._sub = rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_odom, queue_size=50)
+        self.total = 0.0       # [m] since the first sample
+        self.history = {} if history else None
+        # a history needs every sample: a long queue rides out a busy moment of this process
+        self._sub = rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_odom,
+                                     queue_size=2000 if history else 50)
 
     def _on_odom(self, msg):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         yaw = yaw_of(q)
         with self._lock:
             if self.pose is not None:
-                self.length += math.hypot(p.x - self.pose[0], p.y - self.pose[1])
+                step = math.hypot(p.x - self.pose[0], p.y - self.pose[1])
+                self.length += step
+                self.total += step
             self.pose = (p.x, p.y, yaw)
+            if self.history is not None:
+                self.history[msg.header.stamp.to_nsec()] = (p.x, p.y, yaw, self.total)
 
     def reset(self):
         with self._lock:
