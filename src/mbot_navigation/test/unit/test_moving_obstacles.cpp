@@ -79,7 +79,7 @@ struct Fixture
   static MovingObstaclesConfig defaults()
   {
     MovingObstaclesConfig c;
-    c.prediction_time = 2.0;  // as nav_costmaps.yaml
+    c.prediction_time = 2.0;  // 0.5 s of passable sweep after the blocked part, as nav_costmaps.yaml
     c.blocked_time = 1.5;
     return c;
   }
