@@ -288,10 +288,10 @@ void StageRos::publishMarkers()
 
     m.ns = "robot_names";
     m.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
-    m.pose.position.y += world_->robotModel(id).footprint_radius + 0.35;
+    m.pose.position.y += world_->robotModel(id).footprint_radius + 0.2;
     m.pose.position.z = 0.5;
     m.scale.x = m.scale.y = 0.0;
-    m.scale.z = 0.45;  // text height [m]
+    m.scale.z = 0.3;  // text height [m]: a robot 1 m away keeps its name apart
     m.color.r = m.color.g = m.color.b = 1.0f;
     m.color.a = 1.0f;
     m.text = world_->robotName(id);

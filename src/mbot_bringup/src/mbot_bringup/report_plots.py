@@ -141,8 +141,8 @@ def snapshot_indices(series, run):
     chosen = sorted(set(fixed))
     for d in np.linspace(path[first], path[last], STYLE.snapshots):
         i = min(last, int(np.searchsorted(path, d)))
-        if i not in chosen and all(abs(path[i] - path[j]) >= apart and abs(series.t[i] - series.t[j]) >= STYLE.snapshot_dt
-                                   for j in chosen):
+        if i not in chosen and all(abs(path[i] - path[j]) >= apart
+                                   and abs(series.t[i] - series.t[j]) >= STYLE.snapshot_dt for j in chosen):
             chosen.append(i)
     return sorted(chosen)
 

@@ -22,6 +22,7 @@ each step did and when), screenshots/*.png, launch.log, ros_logs/.
 
 ScenarioPlayer is also what the scenario rostests use (test/rostest/scenario_check.py).
 """
+import contextlib
 import json
 import math
 import os
@@ -100,15 +101,56 @@ def view_drawn(path, background=(48, 48, 48), share=0.05):
     return differs.mean() >= share
 
 
+@contextlib.contextmanager
+def _nothing():
+    yield
+
+
+class SimPause(object):
+    """`with SimPause(settle)():` the simulator paused (/pause_physics), `settle` s of wall time
+    for rviz to draw what it has, then the body (the capture), then /unpause_physics whatever
+    happened. A simulator that does not answer is not waited for: the shot is taken anyway."""
+
+    def __init__(self, settle=1.5, timeout=5.0):
+        self.settle = settle     # [s wall] rviz draws 2-5 frames per second with software GL
+        self.timeout = timeout   # [s wall] for the services to appear
+
+    @contextlib.contextmanager
+    def __call__(self):
+        import rospy
+        from std_srvs.srv import Empty
+
+        paused = False
+        try:
+            rospy.wait_for_service("/pause_physics", self.timeout)
+            rospy.ServiceProxy("/pause_physics", Empty)()
+            paused = True
+            time.sleep(self.settle)
+        except (rospy.ROSException, rospy.ServiceException) as error:
+            say("screenshot: could not pause the simulator (%s); taking it anyway" % error)
+        try:
+            yield
+        finally:
+            if paused:
+                try:
+                    rospy.ServiceProxy("/unpause_physics", Empty)()
+                except rospy.ServiceException as error:
+                    say("screenshot: could not unpause the simulator: %s" % error)
+
+
 class Screenshots(object):
     """Takes rviz screenshots of the X display in a thread, so the timeline never waits for one.
-    A blank image (rviz not drawn yet) is taken again, up to `attempts` times `retry` s apart."""
+    A blank image (rviz not drawn yet) is taken again, up to `attempts` times `retry` s apart.
+    With `hold` (a context manager factory, e.g. SimPause), the simulator stands still while a
+    shot is taken: at real_time_factor 0 sim time runs many times faster than software GL draws,
+    and rviz would show a moment seconds old."""
 
-    def __init__(self, display, directory, attempts=4, retry=3.0):
+    def __init__(self, display, directory, attempts=4, retry=3.0, hold=None):
         self.display = display
         self.directory = directory
         self.attempts = attempts
         self.retry = retry               # [s wall]
+        self.hold = hold
         self.taken = []                  # paths of the good ones
         self.names = set()
         self.queue = []
@@ -161,7 +203,8 @@ class Screenshots(object):
             path = os.path.join(self.directory, name + ".png")
             for attempt in range(self.attempts):
                 try:
-                    capture(self.display, path)
+                    with (self.hold() if self.hold is not None else _nothing()):
+                        capture(self.display, path)
                     if view_drawn(path):
                         self.taken.append(path)
                         break
@@ -680,7 +723,9 @@ def run(args):
             time.sleep(0.2)
         rospy.init_node("scenario_runner", disable_signals=True)
         if rviz:
-            screenshots = Screenshots(os.environ["DISPLAY"], os.path.join(run_dir, "screenshots"))
+            # lockstep runs far ahead of rviz: pause for each shot; real time needs no pause
+            screenshots = Screenshots(os.environ["DISPLAY"], os.path.join(run_dir, "screenshots"),
+                                      hold=None if args.real_time else SimPause())
         player = ScenarioPlayer(scenario, robots, run_dir, screenshots)
         try:
             player.wait_ready()

@@ -6,9 +6,9 @@ import os
 import numpy as np
 import pytest
 
-from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, arrival_time, assignment_at, assignments, \
-    compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, speeds, \
-    switch_settling
+from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, arrival_time, assignment_at, \
+    assignments, compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, \
+    speeds, switch_settling
 from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_plots import error_limit, snapshot_indices, snapshot_labels
 from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize

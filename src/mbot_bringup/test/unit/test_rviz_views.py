@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from mbot_bringup.colors import robot_colors
-from mbot_bringup.fleet_rviz import main, write_fleet_view
+from mbot_bringup.fleet_rviz import VIEW_PX, main, write_fleet_view
 from mbot_common.paths import resolve_world
 from mbot_common.world import load_world
 
@@ -96,6 +96,26 @@ def test_fleet_view_is_centred_on_the_map_and_fits_it(tmp_path):
     window = load("fleet")["Window Geometry"]
     assert (x1 - x0) * view["Scale"] <= window["Width"] and (y1 - y0) * view["Scale"] <= window["Height"]
     assert (x1 - x0) * view["Scale"] >= 0.6 * window["Width"] or (y1 - y0) * view["Scale"] >= 0.6 * window["Height"]
+
+
+def test_a_follow_view_tracks_the_fleet_frame_and_fits_a_column(tmp_path):
+    """office (3 robots): 10 m across at least; fleet10-like 10 robots at 1.5 m: the column
+    (13.5 m) and 2 m on each side; never wider than the map (20 m)."""
+    window = load("fleet")["Window Geometry"]
+
+    def view(argv):
+        out = str(tmp_path / "f.rviz")
+        assert main(["--world", "office", "--out", out] + argv) == 0
+        with open(out) as f:
+            return yaml.safe_load(f)["Visualization Manager"]["Views"]["Current"]
+    v = view(["--follow", "fleet", "--spacing", "1.0"])
+    assert v["Target Frame"] == "fleet" and v["X"] == 0.0 and v["Y"] == 0.0
+    assert window["Width"] / v["Scale"] == pytest.approx(10.0, rel=0.05)
+    v = view(["--follow", "fleet", "--view-width", "17.5"])
+    assert window["Width"] / v["Scale"] == pytest.approx(17.5, rel=0.05)
+    v = view(["--follow", "fleet", "--view-width", "50"])
+    assert VIEW_PX[0] / v["Scale"] == pytest.approx(20.0, rel=0.01)                # the map's width
+    assert view(["--follow", ""])["Target Frame"] == "<Fixed Frame>"               # empty: the whole map
 
 
 def test_a_broken_world_is_one_line_and_exit_1(tmp_path, capsys):

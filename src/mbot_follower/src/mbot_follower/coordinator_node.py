@@ -8,8 +8,10 @@ Inputs: ``/fleet/target_pose`` and ``/simulation/target_pose`` (geometry_msgs/Po
 (targets in walls or off the map are refused).
 
 Outputs: ``/fleet/status`` (FleetStatus, on every change and at 2 Hz), ``/fleet/assignment``
-(latched), ``/fleet/markers`` (slots, links, labels, state, a red marker while paused) and the
-leader's move_base goal. ``~debug_mode`` prints every follower's slot error in cm and degrees.
+(latched), ``/fleet/markers`` (slots, links, labels, state, a red marker while paused), the tf
+frame ``~view_frame`` (``fleet``: the middle of the members, not rotated, for an rviz view that
+follows the fleet) and the leader's move_base goal. ``~debug_mode`` prints every follower's
+slot error in cm and degrees.
 """
 import math
 import threading
@@ -33,6 +35,7 @@ NODE_PARAMS = {
     "map_clearance": 0.2,      # a target closer than this to a wall is refused [m]
     "debug_mode": False,       # print every follower's slot error once per second
     "startup_timeout": 60.0,   # [s wall] wait this long for every robot before counting absent ones lost
+    "view_frame": "fleet",     # tf frame at the middle of the fleet ("" = none)
 }
 
 
@@ -98,6 +101,7 @@ class CoordinatorNode(object):
         self.status_pub = rospy.Publisher("/fleet/status", FleetStatus, queue_size=10)
         self.assignment_pub = rospy.Publisher("/fleet/assignment", FleetAssignment, queue_size=1, latch=True)
         self.marker_pub = rospy.Publisher("/fleet/markers", MarkerArray, queue_size=1)
+        self.tf_broadcaster = tf2_ros.TransformBroadcaster()
         # In lockstep the simulator holds sim time until this heartbeat is current: a loss is
         # judged in sim seconds, which must not run away while a busy machine starves this node.
         self.heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10)
@@ -281,11 +285,26 @@ class CoordinatorNode(object):
             self._run(actions, now_ros)
             self._publish_status(stamp=now_ros)
             self.marker_pub.publish(markers.fleet_markers(self.core, poses, now_ros))
+            self._publish_view_frame(poses, now_ros)
             if self.params["debug_mode"] and (self._last_debug is None or now - self._last_debug >= 1.0):
                 self._last_debug = now
                 for robot, (dist, heading) in sorted(self.core.slot_errors(poses).items()):
                     rospy.loginfo("coordinator: %s slot error %.1f cm, %.1f deg", robot, dist * 100.0,
                                   math.degrees(heading))
+
+    def _publish_view_frame(self, poses, stamp):
+        from geometry_msgs.msg import TransformStamped
+
+        center = markers.fleet_center(self.core.members, poses)
+        if not self.params["view_frame"] or center is None:
+            return
+        t = TransformStamped()
+        t.header.stamp = stamp
+        t.header.frame_id = "map"
+        t.child_frame_id = self.params["view_frame"]
+        t.transform.translation.x, t.transform.translation.y = center
+        t.transform.rotation.w = 1.0
+        self.tf_broadcaster.sendTransform(t)
 
     def _started(self, last_heard, now):
         """Startup is a wall-time affair (at real_time_factor 0 sim time races ahead while nodes

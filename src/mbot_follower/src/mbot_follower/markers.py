@@ -1,6 +1,7 @@
 """/fleet/markers for rviz: each slot (a disc where a follower belongs), a line from the leader
 to each follower, a label with each robot's role and slot error, the fleet state above the
-leader, and a red cylinder in front of the leader while the fleet is paused."""
+leader, and a red cylinder in front of the leader while the fleet is paused; and the centre of
+the fleet, where the `fleet` frame is that rviz's view can follow."""
 import math
 
 from mbot_common.geometry import Pose2D, compose
@@ -55,8 +56,8 @@ def fleet_markers(core, poses, stamp):
             links.points += [Point(leader.x, leader.y, 0.05), Point(pose.x, pose.y, 0.05)]
         # below the robot: the simulator's markers write its name above it
         label = _marker("labels", i, Marker.TEXT_VIEW_FACING, stamp, TEXT_COLOR)
-        label.pose.position.x, label.pose.position.y, label.pose.position.z = pose.x, pose.y - 0.45, 0.3
-        label.scale.z = 0.25
+        label.pose.position.x, label.pose.position.y, label.pose.position.z = pose.x, pose.y - 0.35, 0.3
+        label.scale.z = 0.18
         if robot == a.leader:
             label.text = "leader"
         else:
@@ -66,7 +67,7 @@ def fleet_markers(core, poses, stamp):
     array.markers.append(links)
     state = _marker("state", 0, Marker.TEXT_VIEW_FACING, stamp, PAUSE_COLOR if core.paused else TEXT_COLOR)
     state.pose.position.x, state.pose.position.y, state.pose.position.z = leader.x, leader.y + 1.2, 0.5
-    state.scale.z = 0.4
+    state.scale.z = 0.3
     state.text = "%s %s%s" % (core.state(), core.formation, " PAUSED" if core.paused else "")
     array.markers.append(state)
     if core.paused:
@@ -77,3 +78,13 @@ def fleet_markers(core, poses, stamp):
         warn.scale.z = 0.3
         array.markers.append(warn)
     return array
+
+
+def fleet_center(members, poses):
+    """(x, y) [m] of the middle of the box around the members' poses in map, or None when none
+    has a pose: the origin of the `fleet` frame an rviz view follows."""
+    known = [poses[r] for r in members if r in poses]
+    if not known:
+        return None
+    xs, ys = [p.x for p in known], [p.y for p in known]
+    return 0.5 * (min(xs) + max(xs)), 0.5 * (min(ys) + max(ys))

@@ -102,6 +102,22 @@ class FormationChecks(unittest.TestCase):
         final = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
         self.assertLess(max(final.values()), 0.3, "final slot errors %s" % final)
         self.assertNoContacts()
+        self.check_view_frame()
+
+    def check_view_frame(self):
+        """The coordinator's `fleet` frame (rviz follows it) is the middle of the resting fleet."""
+        import tf2_ros
+
+        buffer = tf2_ros.Buffer()
+        listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
+        t = buffer.lookup_transform("map", "fleet", rospy.Time(0), rospy.Duration(5.0)).transform
+        xs = [v[1].x for v in self.probe.truth.values()]
+        ys = [v[1].y for v in self.probe.truth.values()]
+        middle = (0.5 * (min(xs) + max(xs)), 0.5 * (min(ys) + max(ys)))
+        self.assertLess(math.hypot(t.translation.x - middle[0], t.translation.y - middle[1]), 0.1,
+                        "fleet frame at (%.2f, %.2f), the fleet's middle (%.2f, %.2f)"
+                        % (t.translation.x, t.translation.y, middle[0], middle[1]))
+        self.assertAlmostEqual(t.rotation.w, 1.0)
 
     def run_switch(self):
         p = self.probe

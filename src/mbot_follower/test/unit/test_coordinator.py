@@ -413,3 +413,13 @@ def test_a_new_assignment_starts_the_path_anew(tmp_path):
         rigid = compose(leader, Pose2D(x, y, 0.0))
         assert (slots[r].x, slots[r].y) == pytest.approx((rigid.x, rigid.y), abs=1e-9)
         assert slots[r].theta == pytest.approx(leader.theta, abs=1e-9)
+
+
+def test_the_fleet_frame_is_the_middle_of_the_members_that_have_a_pose():
+    from mbot_follower.markers import fleet_center
+
+    poses = {"leader": Pose2D(4.0, 1.0, 0.3), "follower_1": Pose2D(0.0, 3.0, 0.0),
+             "follower_2": Pose2D(1.0, -1.0, 0.0), "lost_one": Pose2D(50.0, 50.0, 0.0)}
+    assert fleet_center(["leader", "follower_1", "follower_2"], poses) == pytest.approx((2.0, 1.0))
+    assert fleet_center(["leader", "gone"], poses) == pytest.approx((4.0, 1.0))
+    assert fleet_center(["gone"], poses) is None
