@@ -101,11 +101,6 @@ def view_drawn(path, background=(48, 48, 48), share=0.05):
     return differs.mean() >= share
 
 
-@contextlib.contextmanager
-def _nothing():
-    yield
-
-
 class SimPause(object):
     """`with SimPause(settle)():` the simulator paused (/pause_physics), `settle` s of wall time
     for rviz to draw what it has, then the body (the capture), then /unpause_physics whatever
@@ -203,7 +198,8 @@ class Screenshots(object):
             path = os.path.join(self.directory, name + ".png")
             for attempt in range(self.attempts):
                 try:
-                    with (self.hold() if self.hold is not None else _nothing()):
+                    hold = self.hold() if self.hold is not None else contextlib.nullcontext()
+                    with hold:
                         capture(self.display, path)
                     if view_drawn(path):
                         self.taken.append(path)

@@ -116,13 +116,19 @@ def test_on_a_straight_drive_path_slots_are_the_rigid_slots():
         assert normalize_angle(slot.theta - theta) == pytest.approx(0.0, abs=1e-9)
 
 
-def test_around_an_l_corner_slots_lie_on_the_path_at_their_arc_length():
-    # Started at the origin facing +x, drove 1.5 m to (1.5, 0), turned left and drove 2 m up to
-    # (1.5, 2): the leader faces +y. Arc lengths behind it: the corner at 2.0, the start at 3.5.
+def _l_corner_trail():
+    """From the origin facing +x, 1.5 m to (1.5, 0), a left turn, 2 m up to (1.5, 2)."""
     trail = Trail()
     trail.start(0.0, 0.0, 0.0)
     _drive(trail, (0.0, 0.0), 0.0, 1.5)
     _drive(trail, (1.5, 0.0), math.pi / 2, 2.0)
+    return trail
+
+
+def test_around_an_l_corner_slots_lie_on_the_path_at_their_arc_length():
+    # Started at the origin facing +x, drove 1.5 m to (1.5, 0), turned left and drove 2 m up to
+    # (1.5, 2): the leader faces +y. Arc lengths behind it: the corner at 2.0, the start at 3.5.
+    trail = _l_corner_trail()
     head = Pose2D(1.5, 2.0, math.pi / 2)
     expected = {1.0: (1.5, 1.0, math.pi / 2), 2.5: (1.0, 0.0, 0.0), 3.0: (0.5, 0.0, 0.0),
                 4.5: (-1.0, 0.0, 0.0)}   # 4.5: 1 m beyond the oldest point, along the tail heading
@@ -135,10 +141,7 @@ def test_around_an_l_corner_slots_lie_on_the_path_at_their_arc_length():
 
 
 def test_at_the_corner_the_heading_is_between_the_two_legs():
-    trail = Trail()
-    trail.start(0.0, 0.0, 0.0)
-    _drive(trail, (0.0, 0.0), 0.0, 1.5)
-    _drive(trail, (1.5, 0.0), math.pi / 2, 2.0)
+    trail = _l_corner_trail()
     corner = path_pose(Pose2D(1.5, 2.0, math.pi / 2), trail, 2.0)
     assert corner[:2] == pytest.approx((1.5, 0.0), abs=1e-9)
     assert corner.theta == pytest.approx(math.pi / 4, abs=1e-9)   # the chord across the corner
@@ -148,10 +151,7 @@ def test_at_the_corner_the_heading_is_between_the_two_legs():
 
 
 def test_lateral_offset_is_to_the_left_of_the_path_direction():
-    trail = Trail()
-    trail.start(0.0, 0.0, 0.0)
-    _drive(trail, (0.0, 0.0), 0.0, 1.5)
-    _drive(trail, (1.5, 0.0), math.pi / 2, 2.0)
+    trail = _l_corner_trail()
     head = Pose2D(1.5, 2.0, math.pi / 2)
     left = path_slot(head, trail, (-1.0, 0.5))     # on the +y leg: left is -x
     assert left[:2] == pytest.approx((1.0, 1.0), abs=1e-9)
@@ -161,10 +161,7 @@ def test_lateral_offset_is_to_the_left_of_the_path_direction():
 
 
 def test_slots_ahead_of_or_beside_the_leader_stay_rigid():
-    trail = Trail()
-    trail.start(0.0, 0.0, 0.0)
-    _drive(trail, (0.0, 0.0), 0.0, 1.5)
-    _drive(trail, (1.5, 0.0), math.pi / 2, 2.0)
+    trail = _l_corner_trail()
     head = Pose2D(1.5, 2.0, math.pi / 2)
     assert path_slot(head, trail, (0.0, 1.0)) == pytest.approx(compose(head, Pose2D(0.0, 1.0, 0.0)))
     assert path_slot(head, trail, (0.0, 0.0)) == pytest.approx(head)
