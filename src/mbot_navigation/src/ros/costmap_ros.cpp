@@ -65,7 +65,21 @@ const std::vector<std::string> kFlatLayerKeys = {"static_map",
                                                  "robots_prediction_step",
                                                  "robots_prediction_cost",
                                                  "robots_padding",
-                                                 "robots_scan_margin"};
+                                                 "robots_scan_margin",
+                                                 "moving_obstacles_layer",
+                                                 "moving_obstacles_prediction_time",
+                                                 "moving_obstacles_prediction_step",
+                                                 "moving_obstacles_prediction_cost",
+                                                 "moving_obstacles_static_margin",
+                                                 "moving_obstacles_cluster_distance",
+                                                 "moving_obstacles_max_size",
+                                                 "moving_obstacles_association_gate",
+                                                 "moving_obstacles_velocity_window",
+                                                 "moving_obstacles_min_track_age",
+                                                 "moving_obstacles_track_timeout",
+                                                 "moving_obstacles_min_speed",
+                                                 "moving_obstacles_max_speed",
+                                                 "moving_obstacles_blocked_time"};
 
 /// The static layer's keys of `p` (the costmap's namespace, or the layer's).
 void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
@@ -149,6 +163,38 @@ void readRobotsLayer(StrictParams& p, const std::string& prefix, CostmapRosSetti
   s.robots_scan_margin = p.getDouble(prefix + "scan_margin", s.robots_scan_margin);
 }
 
+/// The moving obstacles layer (ours): flat keys are moving_obstacles_<key>, in a plugin's namespace
+/// plain <key>. `where` names the namespace in errors (the core names the key).
+void readMovingLayer(StrictParams& p, const std::string& prefix, const std::string& where, CostmapRosSettings& s)
+{
+  MovingObstaclesConfig& m = s.moving;
+  m.prediction_time = p.getDouble(prefix + "prediction_time", m.prediction_time);
+  m.prediction_step = p.getDouble(prefix + "prediction_step", m.prediction_step);
+  const int prediction_cost = p.getInt(prefix + "prediction_cost", m.prediction_cost);
+  if (prediction_cost < 0 || prediction_cost >= cost::INSCRIBED)
+    throw std::runtime_error(where + prefix + "prediction_cost: expected 0..252 (below INSCRIBED), got " +
+                             std::to_string(prediction_cost));
+  m.prediction_cost = static_cast<uint8_t>(prediction_cost);
+  m.static_margin = p.getDouble(prefix + "static_margin", m.static_margin);
+  m.cluster_distance = p.getDouble(prefix + "cluster_distance", m.cluster_distance);
+  m.max_size = p.getDouble(prefix + "max_size", m.max_size);
+  m.association_gate = p.getDouble(prefix + "association_gate", m.association_gate);
+  m.velocity_window = p.getDouble(prefix + "velocity_window", m.velocity_window);
+  m.min_track_age = p.getDouble(prefix + "min_track_age", m.min_track_age);
+  m.track_timeout = p.getDouble(prefix + "track_timeout", m.track_timeout);
+  m.min_speed = p.getDouble(prefix + "min_speed", m.min_speed);
+  m.max_speed = p.getDouble(prefix + "max_speed", m.max_speed);
+  m.blocked_time = p.getDouble(prefix + "blocked_time", m.blocked_time);
+  try
+  {
+    checkMovingObstaclesConfig(m);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw std::runtime_error("parameters " + where + prefix + "*: " + e.what());
+  }
+}
+
 /// costmap_2d's `plugins` list: [{name, type}, ...] -> the layers, each read from its namespace.
 void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, int& prediction_cost,
                  ParamWarnings& w)
@@ -164,8 +210,9 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
       {"costmap_2d::ObstacleLayer", LayerKind::OBSTACLE},
       {"costmap_2d::VoxelLayer", LayerKind::OBSTACLE},
       {"costmap_2d::InflationLayer", LayerKind::INFLATION},
-      {"mbot_navigation::RobotsLayer", LayerKind::ROBOTS}};
-  s.static_map = s.robots_layer = s.inflation = false;
+      {"mbot_navigation::RobotsLayer", LayerKind::ROBOTS},
+      {"mbot_navigation::MovingObstaclesLayer", LayerKind::MOVING}};
+  s.static_map = s.robots_layer = s.inflation = s.moving_obstacles = false;
   s.scan_topic.clear();
   std::vector<LayerKind> seen;
   for (int i = 0; i < list.size(); ++i)
@@ -219,10 +266,18 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
         s.robots_layer = enabled;
         readRobotsLayer(lp, "", s, prediction_cost);
         break;
+      case LayerKind::MOVING:
+        s.moving_obstacles = enabled;
+        readMovingLayer(lp, "", layer_nh.getNamespace() + "/", s);
+        break;
     }
     lp.checkNoUnknown();
   }
   s.layer_order = seen;  // built in the listed order
+  if (s.moving_obstacles && s.scan_topic.empty())
+    throw std::runtime_error("parameter " + param +
+                             ": mbot_navigation::MovingObstaclesLayer tracks what the obstacle layer's LaserScan "
+                             "source sees; list an enabled costmap_2d::ObstacleLayer with one");
   if (!s.inflation)
     w.push_back("parameter " + param + ": no inflation layer, so nothing keeps the robot's radius off obstacles");
   for (const std::string& key : kFlatLayerKeys)
@@ -302,8 +357,11 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
     ip.checkNoUnknown();
     s.robots_layer = p.getBool("robots_layer", d.robots_layer);
     readRobotsLayer(p, "robots_", s, prediction_cost);
+    s.moving_obstacles = p.getBool("moving_obstacles_layer", d.moving_obstacles);
+    readMovingLayer(p, "moving_obstacles_", costmap_nh.getNamespace() + "/", s);
   }
   p.checkNoUnknown();
+  s.moving.obstacle_range = s.obstacle_layer.obstacle_range;  // it tracks what the obstacle layer marks
 
   const std::string ns = costmap_nh.getNamespace() + "/";
   if (prediction_cost < 0 || prediction_cost >= cost::INSCRIBED)
@@ -370,6 +428,11 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
           obstacle_layer_ = static_cast<ObstacleLayer*>(
               &layered_->addLayer(std::make_unique<ObstacleLayer>(settings.obstacle_layer)));
         break;
+      case LayerKind::MOVING:
+        if (settings.moving_obstacles && !settings.scan_topic.empty() && !moving_layer_)
+          moving_layer_ = static_cast<MovingObstaclesLayer*>(
+              &layered_->addLayer(std::make_unique<MovingObstaclesLayer>(settings.moving)));
+        break;
       case LayerKind::ROBOTS:
         if (settings.robots_layer && !robots_layer_)
           robots_layer_ =
@@ -382,9 +445,13 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
         break;
     }
 
+  // People are told from the walls by the map (the static layer's grid, as long as the layer lives).
+  if (moving_layer_ && static_layer_) moving_layer_->setStaticMap(&static_layer_->grid());
+
   // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
   if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
-  if (obstacle_layer_) scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
+  if (obstacle_layer_ || moving_layer_)
+    scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
   if (settings.publish_frequency > 0.0)
     costmap_pub_ = private_nh.advertise<nav_msgs::OccupancyGrid>(name + "/costmap", 1, true);
   grid_msg_.header.frame_id = settings.global_frame;
@@ -460,32 +527,25 @@ void CostmapRos::applyScans(const ros::Time& now)
     obs.origin_y = t.transform.translation.y;
     obs.range_min = scan->range_min;
     obs.range_max = scan->range_max;
+    obs.stamp = scan->header.stamp.toSec();
     const double yaw = tf2::getYaw(t.transform.rotation);
     obs.beams.reserve(scan->ranges.size());
     for (size_t i = 0; i < scan->ranges.size(); ++i)
     {
       const double angle = yaw + scan->angle_min + i * scan->angle_increment;
-      const double r = scan->ranges[i];
-      if (std::isfinite(r) && !teammates_.empty())
-      {
-        // A hit on a teammate is the robots layer's business (it moves; the obstacle layer would
-        // leave a trail of marks behind it): skip the beam.
-        const double hx = obs.origin_x + r * std::cos(angle), hy = obs.origin_y + r * std::sin(angle);
-        bool on_mate = false;
-        for (const TeammateState& m : teammates_)
-          on_mate = on_mate || std::hypot(hx - m.pose.x, hy - m.pose.y) <= m.radius + settings_.robots_scan_margin;
-        if (on_mate) continue;
-      }
-      obs.beams.push_back({angle, r});
+      obs.beams.push_back({angle, scan->ranges[i]});
     }
-    obstacle_layer_->addObservation(obs);
+    // Hits on teammates are the robots layer's (see withoutTeammateHits()).
+    obs = withoutTeammateHits(obs, teammates_, settings_.robots_scan_margin);
+    if (obstacle_layer_) obstacle_layer_->addObservation(obs);
+    if (moving_layer_) moving_layer_->addObservation(obs);
   }
   pending_scans_.swap(keep);
 }
 
 void CostmapRos::update(const Pose2D& robot, const ros::Time& now)
 {
-  if (obstacle_layer_) applyScans(now);
+  if (obstacle_layer_ || moving_layer_) applyScans(now);
   if (robots_layer_)
     robots_layer_->setTeammates(drawableTeammates(teammates_, robot, settings_.costmap.robot_radius,
                                                   settings_.costmap.resolution, settings_.robots_padding));

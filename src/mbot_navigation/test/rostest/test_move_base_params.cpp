@@ -196,6 +196,84 @@ TEST(MoveBaseParams, PluginsPickTheLayers)
 
 namespace
 {
+/// A plugins list of a static layer, an obstacle layer (one LaserScan source, obstacle_range 2.0 m)
+/// when `with_obstacle_layer`, and a moving obstacles layer named "people", in /<ns>/global_costmap.
+void setMovingPlugins(const std::string& ns, bool with_obstacle_layer)
+{
+  XmlRpc::XmlRpcValue list;
+  int i = 0;
+  list[i]["name"] = "static_layer";
+  list[i++]["type"] = "costmap_2d::StaticLayer";
+  if (with_obstacle_layer)
+  {
+    list[i]["name"] = "obstacle_layer";
+    list[i++]["type"] = "costmap_2d::ObstacleLayer";
+    ros::param::set("/" + ns + "/global_costmap/obstacle_layer/observation_sources", std::string("scan"));
+    ros::param::set("/" + ns + "/global_costmap/obstacle_layer/scan/data_type", std::string("LaserScan"));
+    ros::param::set("/" + ns + "/global_costmap/obstacle_layer/scan/clearing", true);
+    ros::param::set("/" + ns + "/global_costmap/obstacle_layer/scan/obstacle_range", 2.0);
+  }
+  list[i]["name"] = "people";
+  list[i]["type"] = "mbot_navigation::MovingObstaclesLayer";
+  ros::param::set("/" + ns + "/global_costmap/plugins", list);
+}
+
+std::string settingsError(const std::string& costmap_ns)
+{
+  try
+  {
+    readCostmapSettings(ros::NodeHandle(costmap_ns), CostmapRosSettings());
+  }
+  catch (const std::runtime_error& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(MoveBaseParams, MovingObstaclesLayerKeysAndErrors)
+{
+  // Listed after the obstacle layer, with its keys in its namespace.
+  setMovingPlugins("moving", true);
+  ros::param::set("/moving/global_costmap/people/min_speed", 0.3);
+  ros::param::set("/moving/global_costmap/people/prediction_time", 1.5);
+  const CostmapRosSettings s = readCostmapSettings(ros::NodeHandle("/moving/global_costmap"), CostmapRosSettings());
+  EXPECT_TRUE(s.moving_obstacles);
+  EXPECT_EQ(s.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::MOVING}));
+  EXPECT_DOUBLE_EQ(s.moving.min_speed, 0.3);
+  EXPECT_DOUBLE_EQ(s.moving.prediction_time, 1.5);
+  EXPECT_DOUBLE_EQ(s.moving.obstacle_range, 2.0);  // the scan source's: it tracks what is marked
+
+  // Without an obstacle layer there is no scan to track people in.
+  setMovingPlugins("moving_alone", false);
+  std::string error = settingsError("/moving_alone/global_costmap");
+  EXPECT_NE(error.find("MovingObstaclesLayer"), std::string::npos) << error;
+  EXPECT_NE(error.find("ObstacleLayer"), std::string::npos) << error;
+
+  // A bad value is an error naming the layer's namespace and the key; so is an unknown key.
+  setMovingPlugins("moving_bad", true);
+  ros::param::set("/moving_bad/global_costmap/people/max_speed", 0.1);  // below min_speed
+  error = settingsError("/moving_bad/global_costmap");
+  EXPECT_NE(error.find("/moving_bad/global_costmap/people/"), std::string::npos) << error;
+  EXPECT_NE(error.find("'max_speed'"), std::string::npos) << error;
+  setMovingPlugins("moving_typo", true);
+  ros::param::set("/moving_typo/global_costmap/people/min_sped", 0.3);
+  error = settingsError("/moving_typo/global_costmap");
+  EXPECT_NE(error.find("min_sped"), std::string::npos) << error;
+
+  // The flat form: moving_obstacles_<key>.
+  ros::param::set("/moving_flat/global_costmap/moving_obstacles_association_gate", -0.5);
+  error = settingsError("/moving_flat/global_costmap");
+  EXPECT_NE(error.find("/moving_flat/global_costmap/moving_obstacles_"), std::string::npos) << error;
+  EXPECT_NE(error.find("'association_gate'"), std::string::npos) << error;
+  ros::param::set("/moving_flat_off/global_costmap/moving_obstacles_layer", false);
+  EXPECT_FALSE(
+      readCostmapSettings(ros::NodeHandle("/moving_flat_off/global_costmap"), CostmapRosSettings()).moving_obstacles);
+}
+
+namespace
+{
 /// A plugins list of a robots layer and an inflation layer, in this order or the other.
 XmlRpc::XmlRpcValue robotsAndInflation(bool inflation_last)
 {
@@ -229,9 +307,10 @@ uint8_t costNearATeammate(const CostmapRosSettings& settings, double x, double y
 TEST(MoveBaseParams, LayersAreStackedInTheListedOrder)
 {
   CostmapRosSettings d;
-  EXPECT_EQ(d.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::ROBOTS,
-                                                   LayerKind::INFLATION}));  // costmap_2d's pre-layer order
-  d.costmap.rolling_window = true;                                           // no map needed
+  // costmap_2d's pre-layer order, with ours (moving obstacles, teammates) before the inflation
+  EXPECT_EQ(d.layer_order, (std::vector<LayerKind>{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::MOVING,
+                                                   LayerKind::ROBOTS, LayerKind::INFLATION}));
+  d.costmap.rolling_window = true;  // no map needed
   d.costmap.width = d.costmap.height = 4.0;
   d.costmap.robot_radius = 0.15;
   ParamWarnings warnings;
@@ -317,6 +396,21 @@ std::vector<std::string> differences(const CostmapRosSettings& a, const CostmapR
   compare("robots.prediction_cost", int(a.robots.prediction_cost), int(b.robots.prediction_cost));
   compare("robots_padding", a.robots_padding, b.robots_padding);
   compare("robots_scan_margin", a.robots_scan_margin, b.robots_scan_margin);
+  compare("moving_obstacles", a.moving_obstacles, b.moving_obstacles);
+  compare("moving.prediction_time", a.moving.prediction_time, b.moving.prediction_time);
+  compare("moving.prediction_step", a.moving.prediction_step, b.moving.prediction_step);
+  compare("moving.prediction_cost", int(a.moving.prediction_cost), int(b.moving.prediction_cost));
+  compare("moving.obstacle_range", a.moving.obstacle_range, b.moving.obstacle_range);
+  compare("moving.static_margin", a.moving.static_margin, b.moving.static_margin);
+  compare("moving.cluster_distance", a.moving.cluster_distance, b.moving.cluster_distance);
+  compare("moving.max_size", a.moving.max_size, b.moving.max_size);
+  compare("moving.association_gate", a.moving.association_gate, b.moving.association_gate);
+  compare("moving.velocity_window", a.moving.velocity_window, b.moving.velocity_window);
+  compare("moving.min_track_age", a.moving.min_track_age, b.moving.min_track_age);
+  compare("moving.track_timeout", a.moving.track_timeout, b.moving.track_timeout);
+  compare("moving.min_speed", a.moving.min_speed, b.moving.min_speed);
+  compare("moving.max_speed", a.moving.max_speed, b.moving.max_speed);
+  compare("moving.blocked_time", a.moving.blocked_time, b.moving.blocked_time);
   compare("layer_order", order(a.layer_order), order(b.layer_order));
   return out;
 }

@@ -41,6 +41,7 @@ struct ScanObservation
   double origin_y = 0.0;                                       ///< [m]
   double range_min = 0.0;                                      ///< [m] (LaserScan.range_min)
   double range_max = std::numeric_limits<double>::infinity();  ///< [m] (LaserScan.range_max)
+  double stamp = 0.0;                                          ///< when it was taken [s] (moving obstacles)
   std::vector<ScanBeam> beams;
 
   /// @brief Add a beam that hit the point (x, y) [m] of the costmap frame (set the origin first).

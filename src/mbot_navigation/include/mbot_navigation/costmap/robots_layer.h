@@ -16,16 +16,14 @@
 #include <vector>
 
 #include "mbot_navigation/costmap/layer.h"
+#include "mbot_navigation/costmap/obstacle_layer.h"
+#include "mbot_navigation/costmap/sweep.h"
 
 namespace mbot_navigation
 {
-/// @brief RobotsLayer settings.
-struct RobotsLayerConfig
-{
-  double prediction_time = 1.0;   ///< how far ahead a teammate's motion is marked [s]
-  double prediction_step = 0.1;   ///< time step of that prediction [s]
-  uint8_t prediction_cost = 200;  ///< cost of the predicted sweep [0..252]; < INSCRIBED: passable
-};
+/// @brief RobotsLayer settings: how far ahead a teammate's sweep is drawn and its cost (sweep.h).
+struct RobotsLayerConfig : SweepPrediction
+{};
 
 /// @brief What the fleet reports about one teammate.
 struct TeammateState
@@ -59,13 +57,18 @@ public:
   std::vector<Pose2D> predict(const TeammateState& mate) const;
 
 private:
-  /// @brief Raise the cells whose centre is within `radius` [m] of (x, y) [m] to `c` (max).
-  static void drawDisc(Costmap2D& master, const CellWindow& window, double x, double y, double radius, uint8_t c);
-
   RobotsLayerConfig config_;
   std::vector<TeammateState> teammates_;
   double robot_radius_ = 0.0;  ///< this robot's radius [m]
   Bounds last_bounds_;         ///< what the previous update drew, to erase it
 };
+
+/**
+ * @brief `scan` without the beams that hit a teammate: a hit within `margin` [m] of a teammate's
+ *        footprint is the robots layer's business (it moves; the obstacle layer would leave a
+ *        trail of marks behind it, and the moving obstacles layer would track it twice).
+ */
+ScanObservation withoutTeammateHits(const ScanObservation& scan, const std::vector<TeammateState>& teammates,
+                                    double margin);
 
 }  // namespace mbot_navigation

@@ -5,7 +5,8 @@
  *        teammates, and publishes the grid as nav_msgs/OccupancyGrid (costmap_2d's 0..100
  *        translation). The layers themselves (layer.h) know nothing of ROS.
  *
- * Layers, bottom to top: static (the map), obstacle (laser), robots (teammates), inflation, or
+ * Layers, bottom to top: static (the map), obstacle (laser), moving obstacles (people, from the
+ * same laser), robots (teammates), inflation, or
  * in the order that `plugins` lists them (each layer works on the grid that the layers below it
  * made: an inflation layer inflates only what is below it). The
  * nav node owns two: `global_costmap` (the size of the map) and `local_costmap` (a rolling window
@@ -15,7 +16,9 @@
  * tells how standard keys this node does not implement are treated; docs/move_base_keys.md lists them):
  *   - `plugins: [{name: N, type: T}, ...]`: the layers listed, T one of costmap_2d::StaticLayer,
  *     costmap_2d::ObstacleLayer (VoxelLayer: read as a 2-D obstacle layer), costmap_2d::InflationLayer,
- *     mbot_navigation::RobotsLayer; each layer's keys in ~<name>/N/ (`enabled: false` leaves it out);
+ *     mbot_navigation::RobotsLayer, mbot_navigation::MovingObstaclesLayer (it tracks the obstacle
+ *     layer's LaserScan source, so it needs that layer); each layer's keys in ~<name>/N/ (`enabled:
+ *     false` leaves it out);
  *   - flat, costmap_2d's pre-layer style (the keys below); `static_map` and `map_type` as there.
  * Flat keys:
  *   global_frame (map), robot_base_frame (<robot>/base_footprint), update_frequency [Hz],
@@ -31,7 +34,9 @@
  *   robots_prediction_cost [0..252], robots_padding [m] (teammates are drawn this much bigger
  *   than their footprint: their reported pose is a little old, and two robots passing each other
  *   keep this gap more), robots_scan_margin [m] (laser hits this close to a teammate's footprint
- *   are not marked as obstacles: the robots layer draws the teammate).
+ *   are not marked as obstacles: the robots layer draws the teammate),
+ *   moving_obstacles_layer (track people in the scans; off without scan_topic), and the keys of
+ *   moving_obstacles_layer.h prefixed `moving_obstacles_` (moving_obstacles_prediction_time [s], ...).
  */
 #pragma once
 
@@ -47,6 +52,7 @@
 
 #include "mbot_navigation/costmap/inflation_layer.h"
 #include "mbot_navigation/costmap/layered_costmap.h"
+#include "mbot_navigation/costmap/moving_obstacles_layer.h"
 #include "mbot_navigation/costmap/obstacle_layer.h"
 #include "mbot_navigation/costmap/robots_layer.h"
 #include "mbot_navigation/costmap/static_layer.h"
@@ -59,6 +65,7 @@ enum class LayerKind
   STATIC,     ///< the map (StaticLayer)
   OBSTACLE,   ///< the laser (ObstacleLayer)
   ROBOTS,     ///< the teammates (RobotsLayer)
+  MOVING,     ///< people and other moving obstacles the laser tracks (MovingObstaclesLayer)
   INFLATION,  ///< InflationLayer
 };
 
@@ -88,9 +95,14 @@ struct CostmapRosSettings
   double robots_padding = 0.1;       ///< [m]
   double robots_scan_margin = 0.15;  ///< [m]
 
+  bool moving_obstacles = true;  ///< built only with a scan source (scan_topic)
+  MovingObstaclesConfig moving;  ///< its obstacle_range is the obstacle layer's
+
   /// The layers bottom to top: costmap_2d's pre-layer order, or the order of `plugins`. A layer
-  /// listed here is built only when it is on (static_map, scan_topic, robots_layer, inflation).
-  std::vector<LayerKind> layer_order{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::ROBOTS, LayerKind::INFLATION};
+  /// listed here is built only when it is on (static_map, scan_topic, moving_obstacles, robots_layer,
+  /// inflation).
+  std::vector<LayerKind> layer_order{LayerKind::STATIC, LayerKind::OBSTACLE, LayerKind::MOVING, LayerKind::ROBOTS,
+                                     LayerKind::INFLATION};
 };
 
 /**
@@ -138,7 +150,7 @@ public:
   unsigned mapCount() const { return map_count_; }
 
   /// @brief The teammates to draw (robots layer, see drawableTeammates()) and to keep out of the
-  ///        obstacle layer, from the next update() on.
+  ///        obstacle and moving obstacles layers, from the next update() on.
   void setTeammates(const std::vector<TeammateState>& teammates);
 
   /// @brief True when update_frequency says that the next update is due at `now`.
@@ -180,6 +192,7 @@ private:
   StaticLayer* static_layer_ = nullptr;
   ObstacleLayer* obstacle_layer_ = nullptr;
   RobotsLayer* robots_layer_ = nullptr;
+  MovingObstaclesLayer* moving_layer_ = nullptr;
   InflationLayer* inflation_layer_ = nullptr;
 
   ros::Subscriber map_sub_, scan_sub_;
