@@ -329,7 +329,12 @@ class MetricsCollector(object):
         at_t = {r: self._pose_at(r, t) for r in self.poses}
         at_t = {r: p for r, p in at_t.items() if p is not None and t - p[0] <= self.config.stale_after}
         fresh = {r: p[1:4] for r, p in at_t.items()}
-        entry = self._in_force(self._assignments, t)
+        # The coordinator stamps a decision's assignment and status alike, but they come on two
+        # topics: a sample taken between them would see the new slots under the old state (a
+        # loss: the survivors' new slots counted as NAVIGATING errors). An assignment counts once
+        # the status of its time is here.
+        decided = min(t, self._statuses[-1][0]) if self._statuses else t
+        entry = self._in_force(self._assignments, decided)
         a, entry_t = (entry[1], entry[0]) if entry is not None else (None, None)
         entry = self._in_force(self._statuses, t)
         state, lost = (entry[1], entry[2]) if entry is not None else ("", ())

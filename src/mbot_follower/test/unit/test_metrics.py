@@ -160,6 +160,26 @@ def test_a_sample_uses_the_assignment_and_status_in_force_at_its_time():
     assert math.isnan(at_21.robots["robot_1"].slot_error)
 
 
+def test_an_assignment_counts_once_the_status_of_its_time_has_come():
+    c = MetricsCollector()
+    c.on_assignment(0.0, wedge())
+    c.on_status(0.0, "NAVIGATING", "goal", [])
+    still = {"robot_0": (0.0, 0.0, 0.0), "robot_1": (-1.0, 0.5, 0.0), "robot_2": (-1.0, -0.5, 0.0)}
+    drive(c, 0.0, 1.98, lambda t: still, at=lambda t: c.on_status(t, "NAVIGATING", "goal", []))
+    # robot_1 is lost at 2.0 s: the new assignment arrives, then the poses that take the sample
+    # at 2.0 s, and only then the status of that decision (it comes on another topic)
+    c.on_assignment(2.0, wedge({"robot_0": (0.0, 0.0), "robot_2": (-1.0, 0.5)}))
+    drive(c, 2.0, 2.06, lambda t: still)
+    at_2 = c.run.samples[-1]
+    assert (at_2.t, at_2.state, at_2.formation) == (2.0, "NAVIGATING", "wedge")
+    assert at_2.robots["robot_2"].slot_error == pytest.approx(0.0)     # its old slot: no 1 m error
+    c.on_status(2.0, "DEGRADED", "lost robot_1", ["robot_1"])
+    drive(c, 2.06, 2.2, lambda t: still, at=lambda t: c.on_status(t, "DEGRADED", "lost robot_1", ["robot_1"]))
+    at_21 = c.run.samples[-1]
+    assert (at_21.t, at_21.state) == (pytest.approx(2.1), "DEGRADED")
+    assert at_21.robots["robot_2"].slot_error == pytest.approx(1.0)    # now the new slot
+
+
 def test_the_lateral_error_uses_the_plan_of_the_leaders_pose_time():
     c = MetricsCollector()
     c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
@@ -402,6 +422,7 @@ def test_files_read_back_into_the_same_run_and_summary(tmp_path):
     # More samples and a robot that appears later (new columns): the files grow and stay whole.
     # robot_1 and robot_2 fall silent at 10 s: the samples wait hold_back (5 s) for them.
     c.on_assignment(10.0, wedge(dict(WEDGE, robot_9=(-2.0, 0.0)), "wedge"))
+    c.on_status(10.0, "NAVIGATING", "robot_9 joined", [])   # the coordinator's status of that decision
     drive(c, 10.0, 15.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
     assert len(c.run.samples) == 100
     drive(c, 15.0, 16.0, lambda t: {"robot_0": (0.0, 0.0, 0.0), "robot_9": (-2.0, 0.1, 0.0)})
