@@ -66,8 +66,8 @@ struct Segment
 /// A 360-beam scan of wall segments and discs, taken at the true pose (x, y, yaw) but placed, as
 /// the nav node places it, at the localization's estimate: the true position plus (ex, ey), the
 /// beams turned by eyaw.
-ScanObservation laserAt(double x, double y, double t, const std::vector<Segment>& walls,
-                        const std::vector<Disc>& discs, double ex, double ey, double eyaw)
+ScanObservation laserAt(double x, double y, double t, const std::vector<Segment>& walls, const std::vector<Disc>& discs,
+                        double ex, double ey, double eyaw)
 {
   const ScanObservation of_discs = laser(x, y, t, discs);  // its beams start at -pi, as below
   ScanObservation s;
