@@ -18,7 +18,11 @@ Every control period (sim time) it
    free, also around corners and through doors, and the follower rejoins its slot once the way
    is clear again. A path shorter than the slot's distance from the leader (it has just set
    off) has no such point: the follower keeps to its slot (its safety layer stops it short of
-   what blocks it) rather than drive ahead of the robots that belong in front of it;
+   what blocks it) rather than drive ahead of the robots that belong in front of it. A column's
+   follower joins the leader's path in slot order (merge.py): while the robot of the slot ahead
+   of its own is not ``~merge_gap`` ahead of it along the path, it waits in a lane
+   ``~merge_lane`` beside the path (mode ``merge``), so two followers coming from a diamond's two
+   sides do not meet on the path and hold each other;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
@@ -40,6 +44,7 @@ from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerC
                                         make_control_law, safety_filter)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
 from mbot_follower.free_space import FreeSpace
+from mbot_follower.merge import merge_target, robot_ahead
 from mbot_follower.trail import Trail, path_pose, path_slot
 
 #: Private parameters of the node itself (the control law's are ControllerConfig's fields).
@@ -54,6 +59,8 @@ NODE_PARAMS = {
     "scan_horizon": 2.0,      # how far along the way to the slot the laser check looks [m]
     "trail_lookahead": 0.6,   # on the trail, drive to the point this far ahead on it [m]
     "path_turn_window": 0.2,  # a path slot turns as the path does over this much path ahead of it [m]
+    "merge_lane": 0.7,        # a column follower waits this far beside the path for its turn [m]
+    "merge_gap": 0.6,         # ... until the robot of the slot ahead is this far ahead along it [m]
 }
 HOLD_STATES = ("IDLE", "ABORTED")
 
@@ -221,11 +228,14 @@ class FollowerController(object):
         started += time.time() - lookup_started  # waiting for tf is not computing: not in cycle_time
         self._record_trail(a, reference, ref_map, now)
         frame, pose, slot, frame_twist = self._slot_frame(a, reference, pose, ref_map)
-        target, mode = self._target(slot, pose, frame, math.hypot(*a.slots[self.robot]))
+        goal, merging = self._merge_goal(a, now, frame, pose, slot) if frame is not ref_map else (slot, False)
+        target, mode = self._target(goal, pose, frame, math.hypot(*a.slots[self.robot]), scan_check=not merging)
+        if merging and mode == "slot":
+            mode = "merge"
         neighbours = []
         if self.params["controller"] == "consensus":
             neighbours = self._neighbours(a, now) if frame is ref_map else self._path_neighbours(a, now, frame)
-        twist = frame_twist if mode == "slot" else Twist2D(frame_twist.vx, 0.0, 0.0)
+        twist = frame_twist if mode in ("slot", "merge") else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
         if self.scan is not None:
@@ -281,6 +291,27 @@ class FollowerController(object):
         twist = Twist2D(speed, 0.0, speed * turn / window if window > 0.0 else 0.0)
         return slot, relative(slot, compose(ref_map, pose)), (0.0, 0.0), twist
 
+    def _merge_goal(self, a, now, frame, pose, slot):
+        """(goal in the path slot's frame, waiting beside the path): a column follower joins the
+        path behind the robot of the slot ahead of its own (merge.py). A lane point in a wall of
+        the map, or an unknown pose of the robot ahead, is no reason to wait."""
+        ahead_robot = robot_ahead(a.slots, self.robot)
+        if ahead_robot is None:
+            return slot, False
+        try:
+            ahead_map, _ = lookup_pose(self.tf_buffer, "map", "%s/base_link" % ahead_robot, now,
+                                       self.params["max_pose_age"])
+        except StalePose:
+            return slot, False
+        ahead = relative(frame, ahead_map)
+        goal, merging = merge_target((pose.x, pose.y), (ahead.x, ahead.y), self.params["merge_lane"],
+                                     self.params["merge_gap"])
+        if merging and self.free_space is not None:
+            goal_map = compose(frame, Pose2D(goal[0], goal[1], 0.0))
+            if not self.free_space.is_free(goal_map.x, goal_map.y):
+                return slot, False
+        return goal, merging
+
     def _rank(self, a, slot):
         """How many follower slots lie farther from the leader than this robot's (GiveWay)."""
         mine = math.hypot(*a.slots[self.robot])
@@ -293,18 +324,20 @@ class FollowerController(object):
         rx, ry = a.slots[reference]
         return sx - rx, sy - ry
 
-    def _target(self, slot, pose, ref_map, behind_leader):
+    def _target(self, slot, pose, ref_map, behind_leader, scan_check=True):
         """(target in the reference robot's frame, mode): the slot, or the trail point when the
         slot or the way to it is blocked. The trail is the leader's: in a chain the point is
         `behind_leader` (the slot's distance from the leader) back on it, not the distance from
-        the robot ahead."""
+        the robot ahead. A follower waiting beside a column's path (merging) does not check its
+        way with the laser: the robots it sees in its lane it waits for, and the trail would take
+        it onto the path out of turn."""
         slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
         me_map = compose(ref_map, pose)
         blocked = False
         if self.free_space is not None:
             blocked = not self.free_space.is_free(slot_map.x, slot_map.y) or not self.free_space.segment_free(
                 me_map.x, me_map.y, slot_map.x, slot_map.y)
-        if not blocked:
+        if not blocked and scan_check:
             blocked = self._scan_blocks(pose, slot)
         point = None
         if blocked and len(self.trail):
@@ -384,7 +417,7 @@ class FollowerController(object):
         msg = self._msg["FollowerState"]()
         msg.header.stamp = now
         msg.robot = self.robot
-        msg.active = mode in ("slot", "trail", "safety_stop", "give_way")
+        msg.active = mode in ("slot", "merge", "trail", "safety_stop", "give_way")
         msg.mode = mode
         if pose_stamp is not None:
             msg.pose_stamp = pose_stamp
