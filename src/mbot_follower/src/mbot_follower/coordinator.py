@@ -295,11 +295,7 @@ class FleetCoordinator(object):
         else the actions (possibly none) of waiting."""
         if self._switch_waits:
             excused = ()
-        for r in list(self._excused_since):
-            if r not in excused:
-                del self._excused_since[r]
-        for r in excused:
-            self._excused_since.setdefault(r, now)
+        self._excused_since = {r: self._excused_since.get(r, now) for r in excused}
         if self._regroup_since is not None:
             # while the leader waits, a follower's excuse must last: one cycle held by its safety
             # layer (turning away from a wall) would let the leader drive off from it

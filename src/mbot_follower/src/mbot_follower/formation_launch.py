@@ -42,13 +42,15 @@ def controller_lines(world, controller="slot_tracking", output="log", config_fil
 
 
 def launch_bool(text):
-    """A roslaunch boolean (true/false/1/0, any case), as roslaunch reads them."""
+    """A roslaunch boolean (true/false/1/0, any case), read by roslaunch's own converter."""
     import argparse
 
-    value = {"true": True, "1": True, "false": False, "0": False}.get(text.strip().lower())
-    if value is None:
+    from roslaunch.loader import convert_value
+
+    try:
+        return convert_value(text.strip(), "bool")
+    except ValueError:
         raise argparse.ArgumentTypeError("expected true or false, got %r" % text)
-    return value
 
 
 def parse_args(argv):
