@@ -18,8 +18,10 @@ def roslaunch_nodes(tmp_path, *args):
               if p and not os.path.abspath(p).startswith(SRC_DIR)]
     env = dict(os.environ, ROS_PACKAGE_PATH=os.pathsep.join([str(packages)] + system), ROS_HOME=str(tmp_path))
     launch = os.path.join(PACKAGE_DIR, "launch", "fleet_navigation.launch")
+    # The timeout only guards against a hang: with an empty ROS_HOME rospack crawls the whole
+    # package path, which took over 60 s on a 2-core machine at load 50.
     return subprocess.run(["roslaunch", "--nodes", launch, "world:=office"] + list(args), env=env,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
 
 
 def test_without_the_simulator_only_the_fleet_node_starts(tmp_path):
