@@ -57,8 +57,8 @@ class FleetProbe(object):
         self.formation_pub = rospy.Publisher("/fleet/formation", String, queue_size=1, latch=True)
         self.modes = {}        # robot -> its follower controller's last mode
         self.heartbeats = {}   # robot -> stamp of its controller's last state [s sim]
-        for r in robots:
-            rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState, self._on_follower, queue_size=5)
+        self._state_subs = {r: rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
+                                                self._on_follower, queue_size=5) for r in robots}
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
 
     def _on_follower(self, msg):
@@ -129,6 +129,15 @@ class FleetProbe(object):
                 continue
             errors[s.robot] = math.hypot(poses[s.robot].x - slots[s.robot].x, poses[s.robot].y - slots[s.robot].y)
         return errors
+
+    def last_heard(self, robot, sim_timeout=30.0):
+        """The stamp of the last state that `robot`'s dead controller sent [s sim], once all of
+        them are in: when its connection to this probe has closed. On a loaded machine a dead
+        controller's last states can reach this process seconds of sim time after it died (a
+        stressed trio_loss read a heartbeat 3.5 s older than the controller's last command)."""
+        sub = self._state_subs[robot]
+        self.wait(lambda: sub.get_num_connections() == 0, sim_timeout, "%s's controller to disconnect" % robot)
+        return self.heartbeats[robot]
 
     def state(self):
         with self.lock:

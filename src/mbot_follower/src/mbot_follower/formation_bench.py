@@ -166,7 +166,7 @@ def drive(n, seed, log):
     t_degraded = probe.wait(lambda: victim in probe.status.lost and victim not in
                             [s.robot for s in probe.assignment.slots], 30.0, "DEGRADED")
     # the loss happened when the controller fell silent (sim time runs on while rosnode kill works)
-    t_kill = max(t_kill, probe.heartbeats.get(victim, t_kill))
+    t_kill = max(t_kill, probe.last_heard(victim))
     result["degraded_s"] = round(t_degraded - t_kill, 2)
     held = []
 

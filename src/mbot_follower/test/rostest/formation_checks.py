@@ -157,7 +157,7 @@ class FormationChecks(unittest.TestCase):
         t_degraded = p.wait(lambda: p.state() == "DEGRADED", 10.0, "DEGRADED")
         # The controller's last word marks the loss (sim time runs on while rosnode kill does its
         # work); a loss is 1 s of silence, and DEGRADED must follow within 1 s of that.
-        silent_since = p.heartbeats["follower_1"]
+        silent_since = p.last_heard("follower_1")
         rospy.loginfo("loss: DEGRADED %.2f s after follower_1's controller fell silent (%.2f s after the kill "
                       "command)", t_degraded - silent_since, t_degraded - t_kill)
         self.assertLess(t_degraded - silent_since, 2.0)
