@@ -37,7 +37,11 @@ ARRIVED) and of regrouping while its slot is blocked, and the reason names it: t
 wait for a place no robot can reach. The follower counts again ``free_hold`` after its slot is
 clear (as in the metrics): a slot just out of the wall is still too close to it to drive into
 (the follower's safety layer stops it 0.8 m short of a wall), so the leader does not stop for it
-until the slot has moved on.
+until the slot has moved on. A lost robot that still stands there (its controller died) blocks
+the slots within ``lost_clearance`` of it in the same way: after a loss the re-planned slot of a
+follower may lie beside the dead robot, where the follower's safety layer stops it, gives way and
+tries again, and a leader waiting for it would wait for ever (until ``regroup_timeout``); once the
+leader drives on, the slot moves away from the dead robot.
 
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
 coordinator records the leader's path from the poses of every update(), started anew with each
@@ -86,6 +90,9 @@ class CoordinatorConfig(object):
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
+        # a slot this close to a lost robot standing there is blocked: a follower's safety layer
+        # stops it 0.8 m short of what it drives towards, + the robot's radius 0.15 m [m]
+        self.lost_clearance = 1.0
         self.topology = "star"                     # who follows whom: star or chain
 
 
@@ -125,8 +132,9 @@ class FleetCoordinator(object):
         self.paused = False
         self.assignment = None
         self.errors = None                   # ShapeErrors of the last update
-        self.blocked = []                    # followers whose slots are (or just were) in a wall
-        self._blocked_at = {}                # follower -> when its slot was last in a wall
+        self.blocked = []                    # followers whose slots are (or just were) blocked
+        self._blocked_at = {}                # follower -> when its slot was last blocked
+        self._blocked_by = {}                # follower -> what blocked it last ("in a wall", ...)
         self.events = []                     # (time, kind, text): switches, losses, rejoins, pauses
         self._stable_since = None
         self._phase_since = 0.0
@@ -228,8 +236,9 @@ class FleetCoordinator(object):
         if self.assignment is not None and self.assignment.leader in poses:
             leader = poses[self.assignment.leader]
             self._trail.add(leader.x, leader.y)
-        for r in self.blocked_followers(poses):
+        for r, why in self.blocked_followers(poses).items():
             self._blocked_at[r] = now
+            self._blocked_by[r] = why
         self.blocked = sorted(r for r, t in self._blocked_at.items() if now - t < self.config.free_hold)
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
@@ -244,7 +253,7 @@ class FleetCoordinator(object):
                 why = "formation reached" if stable else "formation not reached in %.0f s (%s); navigating anyway" % (
                     self.config.forming_timeout, self._worst_follower(poses))
                 if self.blocked:
-                    why += " (%s in a wall: joining on the way)" % self._blocked_text()
+                    why += " (%s: joining on the way)" % self._blocked_text()
                 self._set_phase(NAVIGATING, now, why)
                 self._leader_done_at = None
                 actions.append(("goal", self.leader, self.target))
@@ -282,7 +291,7 @@ class FleetCoordinator(object):
             if stable:
                 why = "the leader is at the target and the formation is stable"
                 if self.blocked:
-                    why += " (%s in a wall)" % self._blocked_text()
+                    why += " (%s)" % self._blocked_text()
                 self._set_phase(ARRIVED, now, why)
             elif now - self._leader_done_at > self.config.arrive_timeout:
                 self._set_phase(ARRIVED, now, "the leader is at the target; formation not stable after %.0f s (%s)" % (
@@ -389,7 +398,7 @@ class FleetCoordinator(object):
             self.assignment = None
             return []
         leader_pose = poses[self.leader]
-        self._blocked_at = {}
+        self._blocked_at, self._blocked_by = {}, {}
         # the leader's path starts here: path slots are the rigid slots at first
         self._trail.start(leader_pose.x, leader_pose.y, leader_pose.theta)
         if len(self.members) == 1:  # the leader alone: no shape to keep
@@ -467,16 +476,26 @@ class FleetCoordinator(object):
         return result
 
     def blocked_followers(self, poses):
-        """The followers whose slots (placed at the leader's pose now) are in a wall of the map."""
-        if self.free_space is None:
-            return []
+        """{follower: why} for the followers whose slots (placed at the leader's pose now) cannot be
+        driven into: "in a wall" of the map, or "beside the lost <robot>" that still stands there
+        (it has a pose: its controller died, not the robot)."""
         a = self.assignment
-        return sorted(r for r, slot in self.slot_poses(poses).items()
-                      if r != a.leader and not self.free_space.is_free(slot.x, slot.y))
+        standing = [(r, poses[r]) for r in self.lost if r in poses]
+        result = {}
+        for r, slot in sorted(self.slot_poses(poses).items()):
+            if r == a.leader:
+                continue
+            if self.free_space is not None and not self.free_space.is_free(slot.x, slot.y):
+                result[r] = "in a wall"
+                continue
+            near = [lost for lost, p in standing
+                    if math.hypot(p.x - slot.x, p.y - slot.y) < self.config.lost_clearance]
+            if near:
+                result[r] = "beside the lost %s" % near[0]
+        return result
 
     def _blocked_text(self):
-        return "%s %s" % (" and ".join("%s's slot" % r for r in self.blocked),
-                          "is" if len(self.blocked) == 1 else "are")
+        return " and ".join("%s's slot is %s" % (r, self._blocked_by[r]) for r in self.blocked)
 
     def _worst_follower(self, poses):
         errors = self.slot_errors(poses)

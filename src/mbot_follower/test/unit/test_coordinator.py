@@ -211,6 +211,45 @@ def test_a_silent_follower_is_lost_and_the_rest_replanned_then_it_rejoins():
     assert "follower_1" in core.assignment.slots
 
 
+def test_a_slot_beside_a_lost_robot_standing_there_is_not_waited_for():
+    """A diamond of 5 loses a rear follower whose robot stands still in its slot (its controller
+    died). In the diamond of 4 the other rear follower's slot is the middle one, 0.53 m beside the
+    dead robot, where its safety layer stops it: the leader does not wait for it until the slot
+    has been clear of the dead robot for free_hold (benchmark seed 4: 15 s of waiting before)."""
+    robots = ["leader", "follower_1", "follower_2", "follower_3", "follower_4"]
+    core = FleetCoordinator(robots, "leader", "diamond", 1.5, CoordinatorConfig())
+    poses = {r: Pose2D(-1.0 * i, 2.0 * (i % 2) - 1.0, 0.0) for i, r in enumerate(robots)}
+    core.set_goal(Pose2D(9.0, 0.0, 0.0), 0.0, poses)
+    t, leader = 0.0, Pose2D(0.0, 0.0, 0.0)
+    while core.phase == FORMING and t < 2.0:
+        t += 0.1
+        poses = at_slots(core, leader)
+        core.update(t, poses, heard(t, robots))
+    assert core.phase == NAVIGATING
+    rear = sorted((r for r in robots if core.assignment.slots[r][0] < -2.0), key=lambda r: core.assignment.slots[r][1])
+    dead, other = rear  # the rear right corner (y < 0) dies, the rear left one stays
+    last, actions = heard(t, robots), []
+    for i in range(12):
+        t += 0.1
+        last.update({r: t for r in robots if r != dead})
+        actions += core.update(t, poses, last, leader_nav="ACTIVE")
+    assert core.lost == [dead] and core.assignment.slots[other] == pytest.approx((-2.12132, 0.0), abs=1e-4)
+    assert core.slot_errors(poses)[other][0] == pytest.approx(0.53, abs=0.01)  # > regroup_error
+    assert ("cancel", "leader") not in actions and core.blocked == [other], core.reason
+    # the leader drives on: 1 m on, the slot is 1.13 m from the dead robot, clear; still not
+    # waited for during free_hold ...
+    leader = Pose2D(1.0, 0.0, 0.0)
+    poses = dict(at_slots(core, leader), **{dead: poses[dead], other: poses[other]})
+    t += 0.1
+    last.update({r: t for r in robots if r != dead})
+    assert core.update(t, poses, last, leader_nav="ACTIVE") == [] and core.blocked == [other]
+    # ... then the follower 1.1 m off its slot is waited for
+    t += core.config.free_hold
+    last.update({r: t for r in robots if r != dead})
+    assert core.update(t, poses, last, leader_nav="ACTIVE") == [("cancel", "leader")]
+    assert core.blocked == [] and "waits for %s" % other in core.reason
+
+
 def test_a_lost_leader_is_replaced_by_the_follower_nearest_its_slot():
     core = make()
     t, poses, _ = formed_and_navigating(core)
