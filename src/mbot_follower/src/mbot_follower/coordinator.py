@@ -31,6 +31,15 @@ the first regroup after a switch waits for every follower, excused or not, until
 ``resume_error`` or ``regroup_timeout`` passes; held followers give way meanwhile (GiveWay), so
 they do not jam for good. The switch is over when its shape is stable or that regroup ended.
 
+Where the map is free ahead of the leader (``switch_room_ahead`` metres, a spacing to either
+side), the leader drives on through a switch and waits only for followers that lag behind their
+new slots (along the slot's heading): a slot behind its follower (a diamond's rear robots
+dropping back into a column) comes to it as the leader drives, and a follower beside its slot
+drives across to it; a standing leader made the rear robots of a 5-robot diamond -> column
+switch drive the whole way back alone. Before a narrow passage the leader stands until the new
+shape is there (a column must stand before a corridor). After ``regroup_timeout`` the whole
+distance to the slot counts again.
+
 A slot in a wall (a column's last slots behind a leader that starts near a wall, slots behind a
 corner) cannot be held. Its follower is left out of the shape checks (FORMING, a switch,
 ARRIVED) and of regrouping while its slot is blocked, and the reason names it: the fleet does not
@@ -88,6 +97,7 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
+        self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         # a slot this close to a lost robot standing there is blocked: a follower's safety layer
@@ -143,6 +153,7 @@ class FleetCoordinator(object):
         self._no_pause_before = -1e9
         self._switch_started = None
         self._switch_waits = False           # after a switch: the leader waits for every follower
+        self._switch_drives = False          # ... but only for those behind their slots (room ahead)
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
@@ -200,6 +211,7 @@ class FleetCoordinator(object):
         self.requested_formation = name
         self._switch_started = now
         self._switch_waits = self.phase == NAVIGATING  # (FORMING waits for every follower anyway)
+        self._switch_drives = self._switch_waits and self.leader in poses and self._room_ahead(poses[self.leader])
         self.events.append((now, "switch", "%s, spacing %.2f m" % (name, spacing)))
         # While navigating, the state stays NAVIGATING: when the robots changing places fall far
         # behind their new slots, the leader waits for them (regrouping, see update()).
@@ -245,7 +257,7 @@ class FleetCoordinator(object):
         if self._switch_started is not None and stable:
             self.events.append((now, "switched", "%s reached in %.1f s" % (self.formation, now - self._switch_started)))
             self._switch_started = None
-            self._switch_waits = False
+            self._switch_waits = self._switch_drives = False
 
         if self.phase == FORMING:
             timed_out = now - self._phase_since > self.config.forming_timeout
@@ -310,7 +322,7 @@ class FleetCoordinator(object):
             # layer (turning away from a wall) would let the leader drive off from it
             excused = [r for r in excused if now - self._excused_since[r] >= self.config.excuse_time]
         excused = set(excused) | set(self.blocked)
-        errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r not in excused}
+        errors = {r: e for r, e in self._regroup_errors(now, poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
         if self._regroup_since is None:
             if worst is None or worst[1] <= self.config.regroup_error or now < self._no_regroup_before:
@@ -331,6 +343,28 @@ class FleetCoordinator(object):
                 self.config.regroup_timeout, worst[0], worst[1])
         self.events.append((now, "resume", self.reason))
         return [("goal", self.leader, self.target)]
+
+    def _regroup_errors(self, now, poses):
+        """{follower: how far off its slot it is for regrouping [m]}: the distance, or while the
+        leader drives through a switch (module docstring) how far it lags behind its slot."""
+        if not (self._switch_drives and self._switch_started is not None
+                and now - self._switch_started < self.config.regroup_timeout):
+            return {r: e for r, (e, _) in self.slot_errors(poses).items()}
+        slots = self.slot_poses(poses)
+        return {r: max(0.0, (s.x - poses[r].x) * math.cos(s.theta) + (s.y - poses[r].y) * math.sin(s.theta))
+                for r, s in slots.items() if r != self.assignment.leader and r in poses}
+
+    def _room_ahead(self, leader):
+        """The map is free for switch_room_ahead metres ahead of the leader, a spacing to either
+        side (no map: free): room to change places on the move."""
+        if self.free_space is None:
+            return True
+        c, s = math.cos(leader.theta), math.sin(leader.theta)
+        for ahead in np.arange(0.0, self.config.switch_room_ahead + 1e-9, 0.25):
+            for side in np.linspace(-self.spacing, self.spacing, 5):
+                if not self.free_space.is_free(leader.x + ahead * c - side * s, leader.y + ahead * s + side * c):
+                    return False
+        return True
 
     # --- losses -------------------------------------------------------------------------------
 
@@ -510,7 +544,7 @@ class FleetCoordinator(object):
         self.phase = phase
         self._phase_since = now
         self._regroup_since = None
-        self._switch_waits = False
+        self._switch_waits = self._switch_drives = False
         self.reason = reason
 
 

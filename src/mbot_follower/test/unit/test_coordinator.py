@@ -432,6 +432,33 @@ def test_after_the_switch_regroup_ends_excused_followers_no_longer_hold_up_the_l
     assert core.update(t, off, heard(t), leader_nav="ACTIVE", excused=["follower_1", "follower_2"]) == []
 
 
+def test_with_room_ahead_the_leader_drives_through_a_switch_and_waits_only_for_followers_behind():
+    core = make()   # no map: room everywhere
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("column", t, poses)
+    # on the triangle's slots (2.17 m behind the leader) the column's slots (2.5 and 5 m) are
+    # behind both followers: the leader driving on brings them closer, so it does not wait
+    for i in range(5):
+        t += 0.1
+        assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == []
+    assert "regrouping" not in core.reason
+    # a follower 1 m behind its slot falls further behind while the leader drives: it waits
+    slots = core.slot_poses(poses)
+    late = dict(poses, follower_1=Pose2D(slots["follower_1"].x - 1.0, slots["follower_1"].y, 0.0))
+    t += 0.1
+    assert core.update(t, late, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    assert "follower_1 (1.00 m off its slot)" in core.reason
+
+
+def test_before_a_narrow_passage_the_leader_stands_through_a_switch():
+    # the same switch with a wall 2 m ahead of the leader: it waits until every follower is there
+    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, CoordinatorConfig(), free_space=FakeFreeSpace())
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("column", t, poses)
+    assert core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
+    assert "regrouping" in core.reason
+
+
 # --- a column along the leader's path --------------------------------------------------------
 
 def l_path(s):
