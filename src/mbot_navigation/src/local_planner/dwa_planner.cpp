@@ -37,10 +37,22 @@ DwaPlanner::DwaPlanner(const DwaConfig& config)
 
 void DwaPlanner::setPlan(const std::vector<Pose2D>& plan)
 {
+  // The nav node replans periodically (planner_frequency): a new plan to the same goal must not
+  // interrupt the final approach (the latch, the rotation in place), only a new goal does.
+  const bool same_goal = !plan_.empty() && !plan.empty() && sameGoal(plan_.back(), plan.back());
   plan_ = plan;
+  oscillation_critic_.reset();  // as dwa_local_planner: the new plan may lead the other way
+  if (same_goal) return;
   xy_latched_ = false;
   rotating_to_goal_ = false;
-  oscillation_critic_.reset();
+}
+
+bool DwaPlanner::sameGoal(const Pose2D& a, const Pose2D& b)
+{
+  constexpr double kSamePosition = 0.01;  // [m]
+  constexpr double kSameYaw = 0.01;       // [rad]
+  return std::hypot(a.x - b.x, a.y - b.y) <= kSamePosition &&
+         std::fabs(mbot_common::angleDiff(a.theta, b.theta)) <= kSameYaw;
 }
 
 void DwaPlanner::prunePlan(const Pose2D& robot_pose)
@@ -72,6 +84,14 @@ LocalPlanResult DwaPlanner::computeVelocityCommands(const Pose2D& robot_pose, co
                                                     const Costmap2D& costmap, Twist2D& cmd)
 {
   cmd = Twist2D{};
+  const LocalPlanResult result = controlCycle(robot_pose, robot_velocity, costmap, cmd);
+  last_cmd_ = cmd;  // zero when the cycle failed: the nav node then commands zero
+  return result;
+}
+
+LocalPlanResult DwaPlanner::controlCycle(const Pose2D& robot_pose, const Twist2D& robot_velocity,
+                                         const Costmap2D& costmap, Twist2D& cmd)
+{
   if (plan_.empty())
   {
     LocalPlanResult result;
@@ -204,17 +224,26 @@ LocalPlanResult DwaPlanner::followPlan(const Pose2D& robot_pose, const Twist2D& 
   return result;
 }
 
+double DwaPlanner::slower(double measured, double commanded)
+{
+  if (measured * commanded <= 0.0) return 0.0;  // standing, or one of them says the other way
+  return std::fabs(measured) < std::fabs(commanded) ? measured : commanded;
+}
+
 LocalPlanResult DwaPlanner::stopAndRotate(const Pose2D& robot_pose, const Twist2D& robot_velocity, Twist2D& cmd)
 {
   LocalPlanResult result;
   const double dt = config_.simPeriod();
   const double yaw_error = mbot_common::angleDiff(plan_.back().theta, robot_pose.theta);
 
-  // The gentlest stop the acceleration limits allow; translation always ends with it here.
+  // The gentlest stop the acceleration limits allow; translation always ends with it here. It
+  // starts from the slower of the measured velocity and the last command: from the measured one
+  // alone, noisy odometry steers the "brake" (with mbot_sim's noise a robot in the goal area sped
+  // up from 0.08 to 0.44 m/s and left it). So the braking commands never grow.
   Twist2D brake;
-  brake.vx = stepTowards(robot_velocity.vx, 0.0, config_.acc_lim_x * dt);
-  brake.vy = stepTowards(robot_velocity.vy, 0.0, config_.acc_lim_y * dt);
-  brake.wz = stepTowards(robot_velocity.wz, 0.0, config_.acc_lim_theta * dt);
+  brake.vx = stepTowards(slower(robot_velocity.vx, last_cmd_.vx), 0.0, config_.acc_lim_x * dt);
+  brake.vy = stepTowards(slower(robot_velocity.vy, last_cmd_.vy), 0.0, config_.acc_lim_y * dt);
+  brake.wz = stepTowards(slower(robot_velocity.wz, last_cmd_.wz), 0.0, config_.acc_lim_theta * dt);
   const bool stopped = std::fabs(robot_velocity.vx) <= config_.trans_stopped_vel &&
                        std::fabs(robot_velocity.vy) <= config_.trans_stopped_vel &&
                        std::fabs(robot_velocity.wz) <= config_.theta_stopped_vel;

@@ -38,7 +38,8 @@ public:
   DwaPlanner& operator=(const DwaPlanner&) = delete;
 
   /// @brief A new global plan, in the frame of the costmaps given to computeVelocityCommands.
-  ///        Clears the goal latch and the oscillation flags.
+  ///        Clears the oscillation flags; a plan to a new goal (another last pose) also clears
+  ///        the goal latch and the rotation to the goal yaw, a new plan to the same goal keeps them.
   void setPlan(const std::vector<Pose2D>& plan) override;
 
   /**
@@ -64,6 +65,14 @@ public:
   double footprintRadius() const override { return config_.footprint_radius; }
 
 private:
+  /// The two goal poses are the same (within 1 cm and 0.01 rad).
+  static bool sameGoal(const Pose2D& a, const Pose2D& b);
+  /// Of a measured and a commanded velocity on one axis, the one nearer zero; zero when their
+  /// signs differ.
+  static double slower(double measured, double commanded);
+  /// computeVelocityCommands without remembering the command.
+  LocalPlanResult controlCycle(const Pose2D& robot_pose, const Twist2D& robot_velocity, const Costmap2D& costmap,
+                               Twist2D& cmd);
   /// Within xy_goal_tolerance of the goal (or latched there).
   bool positionReached(const Pose2D& robot_pose) const;
   /// Drop the plan poses before the first one within 1 m of the robot (base_local_planner's
@@ -100,6 +109,7 @@ private:
 
   bool xy_latched_ = false;        ///< reached the goal position once (latch_xy_goal_tolerance)
   bool rotating_to_goal_ = false;  ///< stopped at the goal position, now turning
+  Twist2D last_cmd_;               ///< the last cycle's command (zero after a failed cycle)
 
   // Reused per cycle (no allocation once sized).
   Trajectory candidate_;
