@@ -22,6 +22,35 @@ PfLocalizer::PfLocalizer(const PfLocalizerConfig& config, const OccupancyGridDat
     throw std::invalid_argument("rest_d, rest_a: expected >= 0");
   if (config_.resample_interval < 1)
     throw std::invalid_argument("resample_interval: expected >= 1, got " + std::to_string(config_.resample_interval));
+  if (!(config_.recovery_alpha_slow >= 0.0 && config_.recovery_alpha_slow <= 1.0) ||
+      !(config_.recovery_alpha_fast >= 0.0 && config_.recovery_alpha_fast <= 1.0))
+    throw std::invalid_argument("recovery_alpha_slow, recovery_alpha_fast: expected in [0, 1], got " +
+                                std::to_string(config_.recovery_alpha_slow) + ", " +
+                                std::to_string(config_.recovery_alpha_fast));
+  collectFreeCells();
+}
+
+void PfLocalizer::collectFreeCells()
+{
+  free_cells_.clear();
+  const LikelihoodField& f = *field_;
+  for (unsigned my = 0; my < f.height(); ++my)
+    for (unsigned mx = 0; mx < f.width(); ++mx)
+      if (f.isFree(f.originX() + (mx + 0.5) * f.resolution(), f.originY() + (my + 0.5) * f.resolution()))
+        free_cells_.push_back(static_cast<size_t>(my) * f.width() + mx);
+}
+
+Pose2D PfLocalizer::randomFreePose(std::mt19937& rng) const
+{
+  const LikelihoodField& f = *field_;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Pose2D p;
+  p.theta = normalizeAngle(2.0 * M_PI * unit(rng));
+  if (free_cells_.empty()) return p;  // no free cell: nothing better than the origin
+  const size_t cell = free_cells_[std::uniform_int_distribution<size_t>(0, free_cells_.size() - 1)(rng)];
+  p.x = f.originX() + (static_cast<double>(cell % f.width()) + unit(rng)) * f.resolution();
+  p.y = f.originY() + (static_cast<double>(cell / f.width()) + unit(rng)) * f.resolution();
+  return p;
 }
 
 void validateConfig(const PfLocalizerConfig& config)
@@ -36,6 +65,7 @@ void PfLocalizer::setMap(const OccupancyGridData& map)
 {
   field_ = std::make_shared<LikelihoodField>(map, config_.likelihood_max_dist);
   laser_ = LikelihoodFieldModel(config_.laser, field_);
+  collectFreeCells();
 }
 
 void PfLocalizer::setInitialPose(const Pose2D& pose, const std::array<double, 9>& covariance)
@@ -45,6 +75,7 @@ void PfLocalizer::setInitialPose(const Pose2D& pose, const std::array<double, 9>
   has_estimate_ = false;
   force_update_ = true;
   updates_since_init_ = 0;
+  w_slow_ = w_fast_ = 0.0;
 }
 
 bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan, const Pose2D& laser_in_base)
@@ -75,7 +106,15 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
   force_update_ = false;
   last_odom_ = odom_pose;
 
-  laser_.apply(scan, laser_in_base, filter_.particles());
+  double fit = 0.0;
+  laser_.apply(scan, laser_in_base, filter_.particles(), &fit);
+  if (std::isfinite(fit))
+  {
+    // amcl's recovery averages: started at the first fit, then exponential
+    last_fit_ = fit;
+    w_slow_ = w_slow_ == 0.0 ? fit : w_slow_ + config_.recovery_alpha_slow * (fit - w_slow_);
+    w_fast_ = w_fast_ == 0.0 ? fit : w_fast_ + config_.recovery_alpha_fast * (fit - w_fast_);
+  }
   filter_.normalizeWeights();
   estimate_ = config_.cluster_estimate ? filter_.bestClusterEstimate() : filter_.estimate();
   odom_at_estimate_ = odom_pose;
@@ -84,7 +123,14 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
   ++updates_since_init_;
   // the weights carry over between updates until the set is resampled (counted from the
   // initialization: the first scan alone does not collapse a fresh set)
-  if (updates_since_init_ % config_.resample_interval == 0) filter_.resample();
+  if (updates_since_init_ % config_.resample_interval == 0)
+  {
+    const bool recovery = config_.recovery_alpha_slow > 0.0 && config_.recovery_alpha_fast > 0.0 && w_slow_ > 0.0;
+    const double random_fraction = recovery ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+    random_particles_ +=
+        filter_.resample(random_fraction, [this](std::mt19937& rng) { return randomFreePose(rng); });
+    if (random_fraction > 0.0) w_slow_ = w_fast_ = 0.0;  // as amcl: start the averages again
+  }
   return true;
 }
 

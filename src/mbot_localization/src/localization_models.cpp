@@ -173,17 +173,22 @@ double logScoreBeams(const std::vector<Beam>& beams, const Pose2D& laser_in_map,
 }  // namespace
 
 double LikelihoodFieldModel::apply(const LaserScanData& scan, const Pose2D& laser_in_base,
-                                   std::vector<Particle>& particles) const
+                                   std::vector<Particle>& particles, double* fit) const
 {
   double range_max = 0.0;
   const std::vector<Beam> beams = selectBeams(scan, config_, range_max);
   std::vector<double> log_p(particles.size());
   double best = -std::numeric_limits<double>::infinity();
+  // per beam, so that the fit does not depend on the number of beams (a product of 60 beam
+  // scores swings by orders of magnitude when one person hides a wall)
+  double mean_fit = 0.0;
   for (size_t i = 0; i < particles.size(); ++i)
   {
     log_p[i] = logScoreBeams(beams, compose(particles[i].pose, laser_in_base), range_max, config_, *field_);
     best = std::max(best, log_p[i]);
+    if (!beams.empty()) mean_fit += particles[i].weight * std::exp(log_p[i] / static_cast<double>(beams.size()));
   }
+  if (fit) *fit = beams.empty() ? std::numeric_limits<double>::quiet_NaN() : mean_fit;
   // A product of many beam scores underflows a double: scale all by the best particle's, which
   // normalizing the weights cancels.
   double total = 0.0;

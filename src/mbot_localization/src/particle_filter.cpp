@@ -92,9 +92,9 @@ size_t ParticleFilter::occupiedBins() const
   return countBins(all);
 }
 
-void ParticleFilter::resample()
+size_t ParticleFilter::resample(double random_fraction, const std::function<Pose2D(std::mt19937&)>& random_pose)
 {
-  if (particles_.empty()) return;
+  if (particles_.empty()) return 0;
   normalizeWeights();
   std::vector<double> weights(particles_.size());
   for (size_t i = 0; i < particles_.size(); ++i) weights[i] = particles_[i].weight;
@@ -106,13 +106,23 @@ void ParticleFilter::resample()
       std::clamp<size_t>(countBins(picked) * config_.particles_per_bin, config_.min_particles, config_.max_particles);
   if (wanted != picked.size()) picked = lowVarianceSample(weights, wanted, rng_);
 
+  const bool inject = random_fraction > 0.0 && random_pose;
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  size_t injected = 0;
   std::vector<Particle> next(picked.size());
   for (size_t m = 0; m < picked.size(); ++m)
   {
-    next[m].pose = particles_[picked[m]].pose;
+    if (inject && uniform(rng_) < random_fraction)
+    {
+      next[m].pose = random_pose(rng_);
+      ++injected;
+    }
+    else
+      next[m].pose = particles_[picked[m]].pose;
     next[m].weight = 1.0 / static_cast<double>(picked.size());
   }
   particles_.swap(next);
+  return injected;
 }
 
 PoseWithCovariance ParticleFilter::meanOf(const std::vector<bool>& member) const

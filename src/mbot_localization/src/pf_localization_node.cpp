@@ -76,6 +76,8 @@ private:
     config_.update_min_a = p.getDouble("update_min_a", config_.update_min_a);
     config_.resample_interval = p.getInt("resample_interval", config_.resample_interval);
     config_.update_at_rest = p.getBool("update_at_rest", config_.update_at_rest);
+    config_.recovery_alpha_slow = p.getDouble("recovery_alpha_slow", config_.recovery_alpha_slow);
+    config_.recovery_alpha_fast = p.getDouble("recovery_alpha_fast", config_.recovery_alpha_fast);
 
     const std::string laser_model = p.getString("laser_model_type", "likelihood_field_prob");
     if (laser_model != "likelihood_field" && laser_model != "likelihood_field_prob")
@@ -196,7 +198,11 @@ private:
       return;
     }
 
+    const size_t random_before = localizer_->randomParticles();
     if (localizer_->processScan(odom, toLaserScanData(msg), mount)) publishEstimate(msg.header.stamp);
+    if (localizer_->randomParticles() > random_before)
+      ROS_INFO_THROTTLE(2.0, "pf_localization: the scans fit the map worse than they did: %zu random particles",
+                        localizer_->randomParticles() - random_before);
 
     // like amcl: re-send the last correction with every scan so that map -> odom stays fresh
     if (tf_broadcast_ && localizer_->hasEstimate())

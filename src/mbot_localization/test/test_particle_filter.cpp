@@ -520,6 +520,83 @@ TEST(PfLocalizer, UpdatesOnceWhenTheRobotComesToRest)
   EXPECT_FALSE(amcl_like.processScan(pose(0.10, 0, 0), scan, mount));
 }
 
+namespace
+{
+/// The robot drives a loop in the room with exact odometry; the filter starts where it is. At
+/// step `kidnap_step` the robot is carried to (1.5, 4.0) without odometry seeing it. Returns the
+/// position error of the final estimate [m]; `random` gets the random particles put in.
+double runKidnapped(uint32_t seed, double alpha_slow, double alpha_fast, int kidnap_step, size_t& random,
+                    double& fit_before, double& fit_after)
+{
+  const OccupancyGridData room = makeRoom();
+  PfLocalizerConfig config;
+  config.filter.min_particles = 300;
+  config.filter.max_particles = 3000;
+  config.motion.alpha1 = config.motion.alpha2 = config.motion.alpha3 = config.motion.alpha4 = 0.01;
+  config.laser.sigma_hit = 0.1;
+  config.laser.max_beams = 60;
+  config.recovery_alpha_slow = alpha_slow;
+  config.recovery_alpha_fast = alpha_fast;
+  PfLocalizer localizer(config, room, seed);
+  std::mt19937 world_rng(seed + 1000);
+  const Pose2D mount;
+  Pose2D truth = pose(1.0, 1.0, 0.0);
+  Pose2D odom = pose(0.0, 0.0, 0.0);
+  std::array<double, 9> cov{};
+  cov[0] = cov[4] = 0.05 * 0.05;
+  cov[8] = 0.05 * 0.05;
+  localizer.setInitialPose(truth, cov);
+  // a rectangle through the room, round and round
+  const std::vector<std::pair<double, double>> corners = {{1.0, 1.0}, {2.8, 1.0}, {2.8, 4.5}, {8.5, 4.5},
+                                                          {8.5, 3.5}, {4.5, 3.5}, {4.5, 4.5}, {1.0, 4.5}};
+  size_t next = 1;
+  fit_before = fit_after = 0.0;
+  for (int step = 0; step < 1200; ++step)
+  {
+    if (step == kidnap_step)
+    {
+      fit_before = localizer.lastFit();
+      truth = pose(1.5, 4.0, truth.theta);  // odometry does not see it
+      next = 7;
+    }
+    const double dx = corners[next].first - truth.x, dy = corners[next].second - truth.y;
+    if (std::hypot(dx, dy) < 0.1)
+    {
+      next = (next + 1) % corners.size();
+      continue;
+    }
+    const double heading_error = angleDiff(std::atan2(dy, dx), truth.theta);
+    Pose2D motion;
+    motion.theta = std::clamp(heading_error, -0.3, 0.3);
+    motion.x = std::fabs(heading_error) < 0.3 ? 0.1 : 0.0;
+    truth = compose(truth, motion);
+    odom = compose(odom, motion);
+    localizer.processScan(odom, simulateScan(room, compose(truth, mount), 90, 8.0, 0.01, world_rng), mount);
+    if (step == kidnap_step + 5) fit_after = localizer.lastFit();
+  }
+  random = localizer.randomParticles();
+  const Pose2D e = localizer.estimate().pose;
+  return std::hypot(e.x - truth.x, e.y - truth.y);
+}
+}  // namespace
+
+// amcl's recovery: when a filter that was right loses the robot (carried away), the scans' fit
+// drops and resampling puts random particles in; with the alphas 0 (amcl's defaults) it does not.
+// (Measured over seeds 1-4: the recovery found the robot again in 2 of 4 runs, ended further off
+// in 2, and also fired while the filter tracked the robot: config/localization.yaml leaves it off.)
+TEST(PfLocalizer, RecoveryPutsRandomParticlesInWhenTheFitDrops)
+{
+  size_t random = 0;
+  double fit_before = 0.0, fit_after = 0.0;
+  runKidnapped(2, 0.0, 0.0, 300, random, fit_before, fit_after);
+  EXPECT_EQ(random, 0u);
+  const double error = runKidnapped(2, 0.001, 0.1, 300, random, fit_before, fit_after);
+  std::printf("[ seed 2 ] with recovery %.3f m off at the end (%zu random particles; fit %.3f -> %.3f)\n", error,
+              random, fit_before, fit_after);
+  EXPECT_GT(random, 0u);
+  EXPECT_LT(fit_after, 0.5 * fit_before) << "the fit did not drop when the robot was carried away";
+}
+
 TEST(ParticleFilter, BestClusterEstimateIgnoresASecondHypothesis)
 {
   ParticleFilterConfig config;

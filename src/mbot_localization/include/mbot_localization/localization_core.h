@@ -37,6 +37,12 @@ struct PfLocalizerConfig
   bool update_at_rest = true;
   /// estimate: mean of the heaviest particle cluster (true, as amcl) or of the whole set
   bool cluster_estimate = true;
+  /// recovery_alpha_slow, recovery_alpha_fast (amcl's; 0: off, as amcl's defaults): averages of
+  /// how well the scans fit the map, one slow and one fast; when the fast one drops below the
+  /// slow one (the robot is likely lost), resampling puts 1 - w_fast / w_slow of the particles
+  /// at random free poses of the map, so that the filter can find the robot again
+  double recovery_alpha_slow = 0.0;
+  double recovery_alpha_fast = 0.0;
   double rest_d = 0.001;  ///< [m] odometry change between two scans that counts as standing still
   double rest_a = 0.002;  ///< [rad]
 };
@@ -81,13 +87,27 @@ public:
   /// @brief Filter updates and resamplings done so far (for logs and tests).
   int updates() const { return updates_; }
 
+  /// @brief The recovery's state (for logs and tests): the last scan's fit (see
+  ///        LikelihoodFieldModel::apply), its slow and fast averages, and the random particles
+  ///        put in so far.
+  double lastFit() const { return last_fit_; }
+  double wSlow() const { return w_slow_; }
+  double wFast() const { return w_fast_; }
+  size_t randomParticles() const { return random_particles_; }
+
   const std::vector<Particle>& particles() const { return filter_.particles(); }
   const PfLocalizerConfig& config() const { return config_; }
   const LikelihoodField& field() const { return *field_; }
 
 private:
+  /// The free cells of the map (indices into the likelihood field), for random poses.
+  void collectFreeCells();
+  /// A pose uniformly drawn over the free cells and headings.
+  Pose2D randomFreePose(std::mt19937& rng) const;
+
   PfLocalizerConfig config_;
   std::shared_ptr<const LikelihoodField> field_;
+  std::vector<size_t> free_cells_;
   ParticleFilter filter_;
   OdomMotionModel motion_;
   LikelihoodFieldModel laser_;
@@ -102,6 +122,10 @@ private:
   Pose2D odom_at_estimate_;
   int updates_ = 0;
   int updates_since_init_ = 0;
+  double last_fit_ = 0.0;
+  double w_slow_ = 0.0;  ///< 0: not started (the next fit starts it, as amcl)
+  double w_fast_ = 0.0;
+  size_t random_particles_ = 0;
 };
 
 /// @brief Check every setting of `config` (the constructors of the filter and its models do).

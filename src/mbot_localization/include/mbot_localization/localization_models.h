@@ -107,9 +107,14 @@ public:
 
   /// @brief Multiply every particle's weight by the likelihood of `scan` seen from it.
   /// @param laser_in_base the laser frame in the robot's base frame [m, m, rad]
+  /// @param fit if not null: how well the scan fits the map as seen from the particles, the
+  ///        weighted mean (by the weights before the update, which must sum to 1) of each
+  ///        particle's per-beam geometric mean likelihood, in (0, 1]; NaN without usable beams.
+  ///        The recovery (amcl's w_slow/w_fast) follows it.
   /// @return the sum of the new weights (all likelihoods are scaled by the best one's, so that
   ///         many beams do not underflow; normalizing the weights cancels the scale)
-  double apply(const LaserScanData& scan, const Pose2D& laser_in_base, std::vector<Particle>& particles) const;
+  double apply(const LaserScanData& scan, const Pose2D& laser_in_base, std::vector<Particle>& particles,
+               double* fit = nullptr) const;
 
   /// @brief The (unnormalized) likelihood of `scan` for one robot pose in the map.
   ///

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -48,7 +49,10 @@ public:
 
   /// @brief Draw a new set with low-variance (systematic) resampling and adapt its size; the
   ///        new particles have equal weights.
-  void resample();
+  /// @param random_fraction each new particle is instead a pose from `random_pose` with this
+  ///        probability (amcl's recovery; 0: none)
+  /// @return the number of random particles
+  size_t resample(double random_fraction = 0.0, const std::function<Pose2D(std::mt19937&)>& random_pose = {});
 
   /// @brief Weighted mean pose and covariance of the set (circular mean for the heading).
   PoseWithCovariance estimate() const;
