@@ -9,6 +9,7 @@ namespace mbot_navigation
 namespace
 {
 constexpr double kPruneDistance = 1.0;  // [m] see prunePlan()
+constexpr double kMinApproach = 0.005;  // [m] a trajectory closer to the goal by less makes no progress
 
 /// The config, after checking it (so that no member is built from a bad one).
 const DwaConfig& validated(const DwaConfig& config)
@@ -44,6 +45,7 @@ void DwaPlanner::setPlan(const std::vector<Pose2D>& plan)
   oscillation_critic_.reset();  // as dwa_local_planner: the new plan may lead the other way
   if (same_goal) return;
   xy_latched_ = false;
+  stopping_at_goal_ = false;
   rotating_to_goal_ = false;
 }
 
@@ -63,11 +65,21 @@ void DwaPlanner::prunePlan(const Pose2D& robot_pose)
   if (near != plan_.end()) plan_.erase(plan_.begin(), near);
 }
 
+double DwaPlanner::goalDistance(const Pose2D& pose) const
+{
+  const Pose2D& goal = plan_.back();
+  return std::hypot(goal.x - pose.x, goal.y - pose.y);
+}
+
 bool DwaPlanner::positionReached(const Pose2D& robot_pose) const
 {
   if (config_.latch_xy_goal_tolerance && xy_latched_) return true;
-  const Pose2D& goal = plan_.back();
-  return std::hypot(goal.x - robot_pose.x, goal.y - robot_pose.y) <= config_.xy_goal_tolerance;
+  // Braking starts within half the tolerance (where the trajectories aim, truncateAtGoal), and
+  // the stop holds while the robot stays within the tolerance. Braking at the edge of the
+  // tolerance would leave the robot there, where its localization error alone (a few cm)
+  // decides whether it truly is within the tolerance.
+  const double radius = stopping_at_goal_ ? config_.xy_goal_tolerance : 0.5 * config_.xy_goal_tolerance;
+  return goalDistance(robot_pose) <= radius;
 }
 
 bool DwaPlanner::isGoalReached(const Pose2D& robot_pose, const Twist2D& robot_velocity) const
@@ -105,10 +117,12 @@ LocalPlanResult DwaPlanner::controlCycle(const Pose2D& robot_pose, const Twist2D
   if (positionReached(robot_pose))
   {
     xy_latched_ = config_.latch_xy_goal_tolerance;
+    stopping_at_goal_ = true;
     obstacle_critic_.prepare(context, error);  // only the collision check is needed here
     return stopAndRotate(robot_pose, robot_velocity, cmd);
   }
-  rotating_to_goal_ = false;  // (pushed) out of the goal area: drive again
+  stopping_at_goal_ = false;  // (pushed) out of the goal area: drive again
+  rotating_to_goal_ = false;
 
   for (TrajectoryCritic* critic : critics_)
   {
@@ -120,7 +134,18 @@ LocalPlanResult DwaPlanner::controlCycle(const Pose2D& robot_pose, const Twist2D
       return result;
     }
   }
-  return followPlan(robot_pose, robot_velocity, cmd);
+  LocalPlanResult result = followPlan(robot_pose, robot_velocity, cmd);
+  // Within the tolerance but not within half of it: stop here after all when the best
+  // trajectory would not bring the robot closer (an obstacle, or the goal in the inflation).
+  const double distance = goalDistance(robot_pose);
+  if (result.ok && distance <= config_.xy_goal_tolerance && !result.trajectory.poses.empty() &&
+      goalDistance(result.trajectory.poses.back()) >= distance - kMinApproach)
+  {
+    xy_latched_ = config_.latch_xy_goal_tolerance;
+    stopping_at_goal_ = true;
+    return stopAndRotate(robot_pose, robot_velocity, cmd);
+  }
+  return result;
 }
 
 bool DwaPlanner::isActive(const TrajectoryCritic& critic) const

@@ -440,6 +440,48 @@ TEST(DwaPlanner, BrakesAtTheGoalOnNoisyOdometry)
   }
 }
 
+// A robot that stops as soon as it is within xy_goal_tolerance stops at the tolerance's edge,
+// where a few centimetres of localization error put it truly outside. It brakes within half the
+// tolerance instead (where the trajectories aim), from any direction of approach.
+TEST(DwaPlanner, StopsWellInsideTheGoalTolerance)
+{
+  DwaConfig c = diffDriveConfig();
+  c.xy_goal_tolerance = 0.1;
+  c.yaw_goal_tolerance = 0.1;
+  Costmap2D map(120, 120, 0.05, 0.0, 0.0);  // 6 x 6 m, free
+  double worst = 0.0;
+  for (int k = 0; k < 8; ++k)
+  {
+    const double a = k * M_PI / 4.0;
+    const Pose2D start{3.0 + 2.0 * std::cos(a), 3.0 + 2.0 * std::sin(a), a + M_PI};
+    DwaPlanner planner(c);
+    planner.setPlan(straightPlan(start.x, start.y, 3.0, 3.0, a));
+    const ClosedLoopRun run = simulate(planner, map, start, 600);
+    ASSERT_TRUE(run.reached) << "approach " << k;
+    worst = std::max(worst, std::hypot(run.final_pose.x - 3.0, run.final_pose.y - 3.0));
+  }
+  EXPECT_LE(worst, 0.6 * c.xy_goal_tolerance);
+}
+
+// Within the tolerance but unable to get closer (the goal inside an obstacle's footprint), the
+// robot still stops and reports the goal reached instead of pressing on.
+TEST(DwaPlanner, StopsWithinTheToleranceWhenItCannotGetCloser)
+{
+  DwaConfig c = diffDriveConfig();
+  c.xy_goal_tolerance = 0.3;
+  Costmap2D map(120, 80, 0.05, 0.0, 0.0);
+  // a wall whose face keeps the robot's centre >= 0.2 m short of the goal at x = 3.0: inside the
+  // tolerance, outside half of it
+  fillBox(map, 3.0 - 0.2 + kRadius, 0.0, 6.0, 4.0);
+  DwaPlanner planner(c);
+  planner.setPlan(straightPlan(1.0, 2.0, 3.0, 2.0, 0.0));
+  const ClosedLoopRun run = simulate(planner, map, Pose2D{1.0, 2.0, 0.0}, 600);
+  ASSERT_TRUE(run.reached) << "final (" << run.final_pose.x << ", " << run.final_pose.y << ")";
+  const double off = std::hypot(run.final_pose.x - 3.0, run.final_pose.y - 2.0);
+  EXPECT_GT(off, 0.5 * c.xy_goal_tolerance);
+  EXPECT_LE(off, c.xy_goal_tolerance);
+}
+
 TEST(DwaPlanner, RespectsAccelerationLimitsOnACurvyPlan)
 {
   for (const DwaConfig& c : {diffDriveConfig(), omniConfig(), mbotOmniConfig(true), mbotOmniConfig(false)})

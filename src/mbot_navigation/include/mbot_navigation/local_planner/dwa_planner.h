@@ -9,7 +9,8 @@
  *
  * One control cycle (computeVelocityCommands):
  *  1. prune the plan poses the robot has left behind;
- *  2. if the goal position is reached: brake, then rotate in place to the goal yaw, then stop;
+ *  2. if the goal position is reached (within half the xy tolerance, or within it when no
+ *     trajectory gets closer): brake, then rotate in place to the goal yaw, then stop;
  *  3. otherwise sample the dynamic window, simulate each sample for sim_time, let the critics
  *     score it (a negative score rejects it) and command the cheapest trajectory's velocity.
  */
@@ -73,7 +74,10 @@ private:
   /// computeVelocityCommands without remembering the command.
   LocalPlanResult controlCycle(const Pose2D& robot_pose, const Twist2D& robot_velocity, const Costmap2D& costmap,
                                Twist2D& cmd);
-  /// Within xy_goal_tolerance of the goal (or latched there).
+  /// Distance [m] from `pose` to the goal position.
+  double goalDistance(const Pose2D& pose) const;
+  /// Where braking for the goal starts: within half the xy_goal_tolerance of the goal; once
+  /// stopping, within the tolerance (or latched there).
   bool positionReached(const Pose2D& robot_pose) const;
   /// Drop the plan poses before the first one within 1 m of the robot (base_local_planner's
   /// prunePlan); nothing when no pose is that close.
@@ -110,6 +114,7 @@ private:
   bool xy_latched_ = false;        ///< reached the goal position once (latch_xy_goal_tolerance)
   bool rotating_to_goal_ = false;  ///< stopped at the goal position, now turning
   Twist2D last_cmd_;               ///< the last cycle's command (zero after a failed cycle)
+  bool stopping_at_goal_ = false;  ///< braking or turning at the goal (until pushed out of the tolerance)
 
   // Reused per cycle (no allocation once sized).
   Trajectory candidate_;
