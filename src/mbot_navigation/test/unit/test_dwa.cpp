@@ -470,9 +470,9 @@ TEST(DwaPlanner, StopsWithinTheToleranceWhenItCannotGetCloser)
   DwaConfig c = diffDriveConfig();
   c.xy_goal_tolerance = 0.3;
   Costmap2D map(120, 80, 0.05, 0.0, 0.0);
-  // a wall whose face keeps the robot's centre >= 0.2 m short of the goal at x = 3.0: inside the
-  // tolerance, outside half of it
-  fillBox(map, 3.0 - 0.2 + kRadius, 0.0, 6.0, 4.0);
+  // a wall 0.1 m beyond the goal at x = 3.0: the obstacle critic keeps the robot's centre about
+  // 0.32 m from its face (measured), inside the tolerance, outside half of it
+  fillBox(map, 3.1, 0.0, 6.0, 4.0);
   DwaPlanner planner(c);
   planner.setPlan(straightPlan(1.0, 2.0, 3.0, 2.0, 0.0));
   const ClosedLoopRun run = simulate(planner, map, Pose2D{1.0, 2.0, 0.0}, 600);
