@@ -219,7 +219,8 @@ def print_table(result):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="scripts/bench", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(prog="scripts/bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("what", choices=["sim", "nav", "formation", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")

@@ -127,8 +127,7 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
   {
     const bool recovery = config_.recovery_alpha_slow > 0.0 && config_.recovery_alpha_fast > 0.0 && w_slow_ > 0.0;
     const double random_fraction = recovery ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
-    random_particles_ +=
-        filter_.resample(random_fraction, [this](std::mt19937& rng) { return randomFreePose(rng); });
+    random_particles_ += filter_.resample(random_fraction, [this](std::mt19937& rng) { return randomFreePose(rng); });
     if (random_fraction > 0.0) w_slow_ = w_fast_ = 0.0;  // as amcl: start the averages again
   }
   return true;
