@@ -9,8 +9,8 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-def run(*args):
-    return subprocess.run([os.path.join(ROOT, "scripts", args[0])] + list(args[1:]), stdout=subprocess.PIPE,
+def run(script, *args):
+    return subprocess.run([os.path.join(ROOT, "scripts", script)] + list(args), stdout=subprocess.PIPE,
                           stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
 
 

@@ -69,7 +69,7 @@ import math
 
 import numpy as np
 
-from mbot_common.geometry import Pose2D, compose, normalize_angle
+from mbot_common.geometry import normalize_angle, relative, transform_point
 from mbot_follower.assignment import assign_single_file, assign_slots
 from mbot_follower.fleet_io import Assignment
 from mbot_follower.formations import FormationError, FormationLibrary
@@ -97,9 +97,9 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
-        self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
+        self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
         # a slot this close to a lost robot standing there is blocked: a follower's safety layer
         # stops it 0.8 m short of what it drives towards, + the robot's radius 0.15 m [m]
         self.lost_clearance = 1.0
@@ -350,20 +350,20 @@ class FleetCoordinator(object):
         if not (self._switch_drives and self._switch_started is not None
                 and now - self._switch_started < self.config.regroup_timeout):
             return {r: e for r, (e, _) in self.slot_errors(poses).items()}
-        slots = self.slot_poses(poses)
-        return {r: max(0.0, (s.x - poses[r].x) * math.cos(s.theta) + (s.y - poses[r].y) * math.sin(s.theta))
-                for r, s in slots.items() if r != self.assignment.leader and r in poses}
+        # the follower's x in its slot's frame: negative when it is behind the slot
+        return {r: max(0.0, -relative(slot, poses[r]).x)
+                for r, slot in self.slot_poses(poses).items() if r != self.assignment.leader and r in poses}
 
     def _room_ahead(self, leader):
         """The map is free for switch_room_ahead metres ahead of the leader, a spacing to either
         side (no map: free): room to change places on the move."""
         if self.free_space is None:
             return True
-        c, s = math.cos(leader.theta), math.sin(leader.theta)
-        for ahead in np.arange(0.0, self.config.switch_room_ahead + 1e-9, 0.25):
-            for side in np.linspace(-self.spacing, self.spacing, 5):
-                if not self.free_space.is_free(leader.x + ahead * c - side * s, leader.y + ahead * s + side * c):
-                    return False
+        for side in np.linspace(-self.spacing, self.spacing, 5):
+            start = transform_point(leader, 0.0, side)
+            end = transform_point(leader, self.config.switch_room_ahead, side)
+            if not self.free_space.segment_free(start[0], start[1], end[0], end[1]):
+                return False
         return True
 
     # --- losses -------------------------------------------------------------------------------
@@ -442,7 +442,7 @@ class FleetCoordinator(object):
             return [("assignment",)]
         formation = self.library.make(self.formation, len(self.members), self.spacing, topology=self.config.topology)
         order = [self.leader] + [r for r in self.members if r != self.leader]
-        slot_world = np.array([_apply(leader_pose, o) for o in formation.offsets])
+        slot_world = np.array([transform_point(leader_pose, *o) for o in formation.offsets])
         positions = np.array([[poses[r].x, poses[r].y] for r in order])
         single_file = formation.along_path and all(abs(o[1]) < 1e-9 for o in formation.offsets)
         slot_of = assign_single_file(positions, slot_world, leader_pose.theta) if single_file \
@@ -546,9 +546,3 @@ class FleetCoordinator(object):
         self._regroup_since = None
         self._switch_waits = self._switch_drives = False
         self.reason = reason
-
-
-def _apply(pose, offset):
-    """A slot offset (x, y) in the frame of `pose` -> map (x, y)."""
-    p = compose(pose, Pose2D(offset[0], offset[1], 0.0))
-    return p.x, p.y

@@ -39,7 +39,7 @@ import time
 
 import rospy
 
-from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative
+from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, energy_rate,
                                         make_control_law, safety_filter)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
@@ -307,8 +307,7 @@ class FollowerController(object):
         goal, merging = merge_target((pose.x, pose.y), (ahead.x, ahead.y), self.params["merge_lane"],
                                      self.params["merge_gap"])
         if merging and self.free_space is not None:
-            goal_map = compose(frame, Pose2D(goal[0], goal[1], 0.0))
-            if not self.free_space.is_free(goal_map.x, goal_map.y):
+            if not self.free_space.is_free(*transform_point(frame, *goal)):
                 return slot, False
         return goal, merging
 

@@ -2,11 +2,13 @@
 switches and refusals, driven with made-up poses."""
 import math
 
+import numpy as np
 import pytest
 
 from mbot_common.geometry import Pose2D, compose
 from mbot_follower.coordinator import (ABORTED, ARRIVED, DEGRADED, FORMING, IDLE, NAVIGATING, CoordinatorConfig,
                                        FleetCoordinator, check_target)
+from mbot_follower.free_space import FreeSpace
 
 ROBOTS = ["leader", "follower_1", "follower_2"]
 
@@ -93,20 +95,18 @@ def test_bad_targets_are_refused_and_nothing_changes(target, words):
     assert core.state() == IDLE and core.target is None and words in core.reason
 
 
-class FakeFreeSpace(object):
-    """Free inside |x|, |y| < 10 except a wall at 2 < x < 3."""
-
-    def cell(self, x, y):
-        return (int(y), int(x)) if abs(x) < 10 and abs(y) < 10 else None
-
-    def is_free(self, x, y):
-        return self.cell(x, y) is not None and not 2 < x < 3
+def walled_room():
+    """Free inside |x|, |y| < 10 except a wall at 2 < x < 3 (0.1 m cells, no clearance)."""
+    centres = -10.0 + 0.1 * (np.arange(200) + 0.5)
+    grid = np.zeros((200, 200), dtype=np.int8)
+    grid[:, (centres > 2.0) & (centres < 3.0)] = 100
+    return FreeSpace(grid, 0.1, (-10.0, -10.0), 0.0)
 
 
 def test_targets_in_walls_or_off_the_map_are_refused():
-    assert "off the map" in check_target(Pose2D(11.0, 0.0, 0.0), FakeFreeSpace())
-    assert "in a wall" in check_target(Pose2D(2.5, 0.0, 0.0), FakeFreeSpace())
-    assert check_target(Pose2D(5.0, 0.0, 0.0), FakeFreeSpace()) is None
+    assert "off the map" in check_target(Pose2D(11.0, 0.0, 0.0), walled_room())
+    assert "in a wall" in check_target(Pose2D(2.5, 0.0, 0.0), walled_room())
+    assert check_target(Pose2D(5.0, 0.0, 0.0), walled_room()) is None
 
 
 class WallBehind(object):
@@ -452,7 +452,7 @@ def test_with_room_ahead_the_leader_drives_through_a_switch_and_waits_only_for_f
 
 def test_before_a_narrow_passage_the_leader_stands_through_a_switch():
     # the same switch with a wall 2 m ahead of the leader: it waits until every follower is there
-    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, CoordinatorConfig(), free_space=FakeFreeSpace())
+    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, CoordinatorConfig(), free_space=walled_room())
     t, poses, _ = formed_and_navigating(core)
     core.set_formation("column", t, poses)
     assert core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
