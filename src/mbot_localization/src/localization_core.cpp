@@ -33,6 +33,7 @@ PfLocalizer::PfLocalizer(const PfLocalizerConfig& config, const OccupancyGridDat
 void PfLocalizer::collectFreeCells()
 {
   free_cells_.clear();
+  if (!recoveryEnabled()) return;  // only random particles need them (a 2000 x 2000 map: 32 MB)
   const LikelihoodField& f = *field_;
   for (unsigned my = 0; my < f.height(); ++my)
     for (unsigned mx = 0; mx < f.width(); ++mx)
@@ -125,8 +126,7 @@ bool PfLocalizer::processScan(const Pose2D& odom_pose, const LaserScanData& scan
   // initialization: the first scan alone does not collapse a fresh set)
   if (updates_since_init_ % config_.resample_interval == 0)
   {
-    const bool recovery = config_.recovery_alpha_slow > 0.0 && config_.recovery_alpha_fast > 0.0 && w_slow_ > 0.0;
-    const double random_fraction = recovery ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+    const double random_fraction = recoveryEnabled() && w_slow_ > 0.0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
     random_particles_ += filter_.resample(random_fraction, [this](std::mt19937& rng) { return randomFreePose(rng); });
     if (random_fraction > 0.0) w_slow_ = w_fast_ = 0.0;  // as amcl: start the averages again
   }

@@ -186,7 +186,7 @@ double LikelihoodFieldModel::apply(const LaserScanData& scan, const Pose2D& lase
   {
     log_p[i] = logScoreBeams(beams, compose(particles[i].pose, laser_in_base), range_max, config_, *field_);
     best = std::max(best, log_p[i]);
-    if (!beams.empty()) mean_fit += particles[i].weight * std::exp(log_p[i] / static_cast<double>(beams.size()));
+    if (fit && !beams.empty()) mean_fit += particles[i].weight * std::exp(log_p[i] / static_cast<double>(beams.size()));
   }
   if (fit) *fit = beams.empty() ? std::numeric_limits<double>::quiet_NaN() : mean_fit;
   // A product of many beam scores underflows a double: scale all by the best particle's, which

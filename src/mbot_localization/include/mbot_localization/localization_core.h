@@ -100,7 +100,9 @@ public:
   const LikelihoodField& field() const { return *field_; }
 
 private:
-  /// The free cells of the map (indices into the likelihood field), for random poses.
+  bool recoveryEnabled() const { return config_.recovery_alpha_slow > 0.0 && config_.recovery_alpha_fast > 0.0; }
+  /// The free cells of the map (indices into the likelihood field), for random poses; none
+  /// while the recovery is off.
   void collectFreeCells();
   /// A pose uniformly drawn over the free cells and headings.
   Pose2D randomFreePose(std::mt19937& rng) const;

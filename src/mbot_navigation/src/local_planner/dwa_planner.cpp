@@ -44,7 +44,6 @@ void DwaPlanner::setPlan(const std::vector<Pose2D>& plan)
   plan_ = plan;
   oscillation_critic_.reset();  // as dwa_local_planner: the new plan may lead the other way
   if (same_goal) return;
-  xy_latched_ = false;
   stopping_at_goal_ = false;
   rotating_to_goal_ = false;
 }
@@ -73,7 +72,7 @@ double DwaPlanner::goalDistance(const Pose2D& pose) const
 
 bool DwaPlanner::positionReached(const Pose2D& robot_pose) const
 {
-  if (config_.latch_xy_goal_tolerance && xy_latched_) return true;
+  if (config_.latch_xy_goal_tolerance && stopping_at_goal_) return true;  // latched at the goal position
   // Braking starts within half the tolerance (where the trajectories aim, truncateAtGoal), and
   // the stop holds while the robot stays within the tolerance. Braking at the edge of the
   // tolerance would leave the robot there, where its localization error alone (a few cm)
@@ -116,7 +115,6 @@ LocalPlanResult DwaPlanner::controlCycle(const Pose2D& robot_pose, const Twist2D
   std::string error;
   if (positionReached(robot_pose))
   {
-    xy_latched_ = config_.latch_xy_goal_tolerance;
     stopping_at_goal_ = true;
     obstacle_critic_.prepare(context, error);  // only the collision check is needed here
     return stopAndRotate(robot_pose, robot_velocity, cmd);
@@ -141,7 +139,6 @@ LocalPlanResult DwaPlanner::controlCycle(const Pose2D& robot_pose, const Twist2D
   if (result.ok && distance <= config_.xy_goal_tolerance && !result.trajectory.poses.empty() &&
       goalDistance(result.trajectory.poses.back()) >= distance - kMinApproach)
   {
-    xy_latched_ = config_.latch_xy_goal_tolerance;
     stopping_at_goal_ = true;
     return stopAndRotate(robot_pose, robot_velocity, cmd);
   }

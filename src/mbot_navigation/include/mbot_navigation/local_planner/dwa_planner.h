@@ -111,10 +111,11 @@ private:
   TwirlingCritic twirling_critic_;
   std::vector<TrajectoryCritic*> critics_;
 
-  bool xy_latched_ = false;        ///< reached the goal position once (latch_xy_goal_tolerance)
+  /// braking or turning at the goal until pushed out of the tolerance (with
+  /// latch_xy_goal_tolerance: until a new goal)
+  bool stopping_at_goal_ = false;
   bool rotating_to_goal_ = false;  ///< stopped at the goal position, now turning
   Twist2D last_cmd_;               ///< the last cycle's command (zero after a failed cycle)
-  bool stopping_at_goal_ = false;  ///< braking or turning at the goal (until pushed out of the tolerance)
 
   // Reused per cycle (no allocation once sized).
   Trajectory candidate_;
