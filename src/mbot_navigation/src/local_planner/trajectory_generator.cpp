@@ -51,9 +51,16 @@ std::vector<double> TrajectoryGenerator::sampleRange(double min, double max, int
   return samples;
 }
 
-void TrajectoryGenerator::initialise(const Twist2D& velocity)
+void TrajectoryGenerator::initialise(const Twist2D& measured)
 {
   const double dt = config_.simPeriod();
+  // Noisy odometry can read a little above a limit (0.58 m/s at 0.5 m/s); the window is built
+  // from the fastest speed the limits allow, else no sample stays within them and the robot
+  // would get a zero command for that cycle.
+  Twist2D velocity = measured;
+  velocity.vx = std::min(std::max(velocity.vx, config_.min_vel_x), config_.max_vel_x);
+  velocity.vy = std::min(std::max(velocity.vy, config_.min_vel_y), config_.max_vel_y);
+  velocity.wz = std::min(std::max(velocity.wz, -config_.max_vel_theta), config_.max_vel_theta);
   // The dynamic window: what one control period of acceleration can reach, within the limits.
   const double max_vx = std::min(config_.max_vel_x, velocity.vx + config_.acc_lim_x * dt);
   const double min_vx = std::max(config_.min_vel_x, velocity.vx - config_.acc_lim_x * dt);
@@ -67,11 +74,9 @@ void TrajectoryGenerator::initialise(const Twist2D& velocity)
   const double max_vth = std::min(config_.max_vel_theta, velocity.wz + config_.acc_lim_theta * dt);
   const double min_vth = std::max(-config_.max_vel_theta, velocity.wz - config_.acc_lim_theta * dt);
 
-  // A robot that is faster than its limits (pushed, or limits just lowered) gets an empty
-  // range on that axis; sampleRange then gives the one reachable value closest to the limits.
-  const auto xs = sampleRange(min_vx, std::max(min_vx, max_vx), config_.vx_samples);
-  const auto ys = sampleRange(min_vy, std::max(min_vy, max_vy), config_.vy_samples);
-  const auto ths = sampleRange(min_vth, std::max(min_vth, max_vth), config_.vth_samples);
+  const auto xs = sampleRange(min_vx, max_vx, config_.vx_samples);
+  const auto ys = sampleRange(min_vy, max_vy, config_.vy_samples);
+  const auto ths = sampleRange(min_vth, max_vth, config_.vth_samples);
 
   samples_.clear();
   samples_.reserve(xs.size() * ys.size() * ths.size());

@@ -261,6 +261,35 @@ TEST(DwaPlanner, FollowsAStraightPlanAtFullSpeed)
   expectWithinAccelerationLimits(run, c);
 }
 
+TEST(DwaPlanner, KeepsDrivingWhenOdometryReadsAboveTheSpeedLimit)
+{
+  // Noisy odometry of a robot cruising at max_vel_x (0.55 m/s) reads 0.7 m/s, more than one
+  // period of acceleration (0.125 m/s) above the limit. The window is built from the limit, so
+  // the robot keeps its speed instead of getting no admissible sample (and a zero command).
+  const DwaConfig c = diffDriveConfig();
+  DwaPlanner planner(c);
+  Costmap2D map(160, 80, 0.05, 0.0, 0.0);  // 8 x 4 m, free
+  planner.setPlan(straightPlan(0.5, 2.0, 7.5, 2.0, 0.0));
+  const double reading = c.max_vel_x + 1.2 * c.acc_lim_x * c.simPeriod();
+  const Pose2D pose{1.0, 2.0, 0.0};
+  Twist2D cmd;
+  const LocalPlanResult r =
+      planner.computeVelocityCommands(pose, Twist2D{reading, 0.0, 0.0}, localWindow(map, pose), cmd);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_NEAR(cmd.vx, c.max_vel_x, 1e-9);
+  EXPECT_LT(std::fabs(cmd.wz), 0.05);
+
+  // The same when the robot turns faster than max_vel_theta reads.
+  TrajectoryGenerator generator(c);
+  generator.initialise(Twist2D{0.3, 0.0, c.max_vel_theta + 2.0 * c.acc_lim_theta * c.simPeriod()});
+  ASSERT_FALSE(generator.samples().empty());
+  for (const Twist2D& s : generator.samples())
+  {
+    EXPECT_LE(s.wz, c.max_vel_theta + 1e-12);
+    EXPECT_GE(s.wz, c.max_vel_theta - c.acc_lim_theta * c.simPeriod() - 1e-12);
+  }
+}
+
 TEST(DwaPlanner, NeverChoosesATrajectoryThroughAWall)
 {
   const DwaConfig c = diffDriveConfig();

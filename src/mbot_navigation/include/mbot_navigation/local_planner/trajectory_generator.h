@@ -21,12 +21,13 @@ public:
   explicit TrajectoryGenerator(const DwaConfig& config);
 
   /**
-   * @brief Compute the velocity samples of the dynamic window around `velocity`.
+   * @brief Compute the velocity samples of the dynamic window around the `measured` velocity.
    *
-   * v_x, v_y and omega are each sampled evenly over [v - acc_lim * sim_period,
+   * The measured velocity is first clipped to the velocity limits (odometry noise can read above
+   * them). Then v_x, v_y and omega are each sampled evenly over [v - acc_lim * sim_period,
    * v + acc_lim * sim_period], clipped to the velocity limits (omega to +-max_vel_theta).
    */
-  void initialise(const Twist2D& velocity);
+  void initialise(const Twist2D& measured);
 
   /// @brief The samples computed by the last initialise().
   const std::vector<Twist2D>& samples() const { return samples_; }
