@@ -38,7 +38,11 @@ dropping back into a column) comes to it as the leader drives, and a follower be
 drives across to it; a standing leader made the rear robots of a 5-robot diamond -> column
 switch drive the whole way back alone. Before a narrow passage the leader stands until the new
 shape is there (a column must stand before a corridor). After ``regroup_timeout`` the whole
-distance to the slot counts again.
+distance to the slot counts again. When every follower is ahead of (or beside) its new slot as
+such a switch starts, the leader drives at ``switch_leader_vel`` (the robots' top speed, above
+the fleet's usual leader speed) until the new shape is reached: the slots come to the followers
+sooner. The action ``("leader_speed", robot, v)`` asks for that speed, ``v`` None for the usual
+one again; a regroup, a pause, a new leader or a new phase ends it.
 
 A slot in a wall (a column's last slots behind a leader that starts near a wall, slots behind a
 corner) cannot be held. Its follower is left out of the shape checks (FORMING, a switch,
@@ -63,7 +67,8 @@ is refused at once: the state does not change and the message says why.
 The node calls ``update()`` every cycle with what it sees (poses, when each robot was last
 heard, the leader's navigation state, an obstacle in front of the leader) and carries out the
 actions it returns: ``("goal", robot, Pose2D)`` send the leader its navigation goal,
-``("cancel", robot)`` cancel it, ``("assignment",)`` publish the new slot assignment.
+``("cancel", robot)`` cancel it, ``("assignment",)`` publish the new slot assignment,
+``("leader_speed", robot, v)`` set the speed limit of that robot's navigation (above).
 """
 import math
 
@@ -100,6 +105,7 @@ class CoordinatorConfig(object):
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
+        self.switch_leader_vel = 0.5               # ... at this speed while the slots come; 0: off [m/s]
         # a slot this close to a lost robot standing there is blocked: a follower's safety layer
         # stops it 0.8 m short of what it drives towards, + the robot's radius 0.15 m [m]
         self.lost_clearance = 1.0
@@ -154,6 +160,8 @@ class FleetCoordinator(object):
         self._switch_started = None
         self._switch_waits = False           # after a switch: the leader waits for every follower
         self._switch_drives = False          # ... but only for those behind their slots (room ahead)
+        self._switch_fast = False            # ... at switch_leader_vel (every follower ahead of its slot)
+        self._fast_leader = None             # the robot whose navigation drives at switch_leader_vel
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
@@ -216,8 +224,12 @@ class FleetCoordinator(object):
         # While navigating, the state stays NAVIGATING: when the robots changing places fall far
         # behind their new slots, the leader waits for them (regrouping, see update()).
         self.reason = "switching to %s" % name
+        actions = self._reassign(poses, now)
+        lags = self._regroup_errors(now, poses).values() if self._switch_drives else ()
+        self._switch_fast = bool(self._switch_drives and self.config.switch_leader_vel > 0
+                                 and max(lags, default=0.0) <= self.config.resume_error)
         return True, "switching to %s (%d robots, spacing %.2f m)" % (name, len(self.members), spacing), \
-            self._reassign(poses, now)
+            actions + self._leader_speed(now, poses)
 
     def _formation_problem(self, name, spacing):
         try:
@@ -271,6 +283,23 @@ class FleetCoordinator(object):
                 actions.append(("goal", self.leader, self.target))
         elif self.phase == NAVIGATING:
             actions += self._navigating(now, poses, leader_nav, obstacle_ahead, stable, excused)
+        return actions + self._leader_speed(now, poses)
+
+    def _leader_speed(self, now, poses):
+        """The leader_speed actions that start or end driving at switch_leader_vel (module docstring)."""
+        if self._switch_fast and self._switch_drives and \
+                max(self._regroup_errors(now, poses).values(), default=0.0) > self.config.resume_error:
+            # a follower fell behind its slot: at the robots' top speed it could not catch up
+            self._switch_fast = False
+        fast = self._switch_fast and self._switch_drives and self.phase == NAVIGATING and not self.paused \
+            and self._regroup_since is None  # (a regroup of before the switch ends at the next update)
+        want = self.leader if fast else None
+        if want == self._fast_leader:
+            return []
+        actions = [("leader_speed", self._fast_leader, None)] if self._fast_leader is not None else []
+        if want is not None:
+            actions.append(("leader_speed", want, self.config.switch_leader_vel))
+        self._fast_leader = want
         return actions
 
     def _navigating(self, now, poses, leader_nav, obstacle_ahead, stable, excused):
@@ -285,6 +314,7 @@ class FleetCoordinator(object):
             return actions
         if obstacle_ahead and now >= self._no_pause_before and self._leader_done_at is None:
             self.paused = True
+            self._switch_fast = False
             self._pause_until = now + self.config.pause_time
             self.reason = "paused: obstacle in front of the leader %s" % self.leader
             self.events.append((now, "pause", self.reason))
@@ -328,6 +358,7 @@ class FleetCoordinator(object):
             if worst is None or worst[1] <= self.config.regroup_error or now < self._no_regroup_before:
                 return None
             self._regroup_since = now
+            self._switch_fast = False  # a follower lags: not faster again in this switch
             self.reason = "regrouping: the leader waits for %s (%.2f m off its slot)" % worst
             self.events.append((now, "regroup", self.reason))
             return [("cancel", self.leader)]
@@ -428,6 +459,7 @@ class FleetCoordinator(object):
     def _reassign(self, poses, now):
         """Give every member a slot: the leader keeps slot 0, the others by least total travel.
         Needs every member's pose; without them the assignment waits for the next cycle."""
+        self._switch_fast = False  # the slots change: set_formation decides again, a loss ends it
         if not all(r in poses for r in self.members):
             self.assignment = None
             return []

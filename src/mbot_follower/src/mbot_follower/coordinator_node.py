@@ -10,10 +10,13 @@ Inputs: ``/fleet/target_pose`` and ``/simulation/target_pose`` (geometry_msgs/Po
 Outputs: ``/fleet/status`` (FleetStatus, on every change and at 2 Hz), ``/fleet/assignment``
 (latched), ``/fleet/markers`` (slots, links, labels, state, a red marker while paused), the tf
 frame ``~view_frame`` (``fleet``: the middle of the members, not rotated, for an rviz view that
-follows the fleet) and the leader's move_base goal. ``~debug_mode`` prints every follower's
-slot error in cm and degrees.
+follows the fleet) and the leader's move_base goal. While the leader drives through a switch
+(coordinator.py) its ``move_base/DWAPlannerROS`` ``max_vel_x`` is raised to
+``~switch_leader_vel`` by dynamic_reconfigure, and set back afterwards. ``~debug_mode`` prints
+every follower's slot error in cm and degrees.
 """
 import math
+import queue
 import threading
 import time
 
@@ -124,6 +127,7 @@ class CoordinatorNode(object):
         self._nav_connected = set()
         self._connect_nav_thread = threading.Thread(target=self._connect_nav, daemon=True)
         self._connect_nav_thread.start()
+        self._leader_speed = NavSpeedLimit()
         self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), self._cycle)
         rospy.loginfo("coordinator: robots %s, leader %s, formation %s (spacing %.2f m)", ", ".join(self.robots),
                       leader, self.core.formation, self.core.spacing)
@@ -372,6 +376,8 @@ class CoordinatorNode(object):
                 rospy.loginfo("coordinator: %s navigates to (%.2f, %.2f)", robot, target.x, target.y)
             elif action[0] == "cancel":
                 self._cancel(action[1])
+            elif action[0] == "leader_speed":
+                self._leader_speed.set(action[1], action[2])
 
     def _cancel(self, robot):
         client = self._nav_clients.get(robot)
@@ -403,6 +409,54 @@ class CoordinatorNode(object):
             msg.rms_error, msg.max_error, msg.fit_rms_error = e.rms, e.max, e.fit_rms
             msg.edge_error, msg.heading_error = e.edge_max, e.heading_max
         self.status_pub.publish(msg)
+
+
+class NavSpeedLimit(object):
+    """Sets a robot's navigation speed limit (``/<robot>/move_base/DWAPlannerROS`` ``max_vel_x``,
+    by dynamic_reconfigure) and sets the usual one back, in a thread of its own: the
+    coordinator's cycle never waits for a service."""
+
+    TIMEOUT = 2.0  # [s wall] for the reconfigure services
+
+    def __init__(self):
+        self._requests = queue.Queue()
+        self._clients = {}
+        self._usual = {}  # robot -> its max_vel_x before it was raised
+        threading.Thread(target=self._work, daemon=True).start()
+
+    def set(self, robot, speed):
+        """Drive `robot` at up to `speed` [m/s] (never slower than usual); None: as usual again."""
+        self._requests.put((robot, speed))
+
+    def _work(self):
+        while not rospy.is_shutdown():
+            robot, speed = self._requests.get()
+            try:
+                self._apply(robot, speed)
+            except Exception as error:  # a dead or missing nav node: the fleet goes on at its speed
+                rospy.logwarn("coordinator: could not set the speed limit of %s's navigation: %s", robot, error)
+
+    def _apply(self, robot, speed):
+        import dynamic_reconfigure.client
+
+        if robot not in self._clients:
+            self._clients[robot] = dynamic_reconfigure.client.Client(
+                "/%s/move_base/DWAPlannerROS" % robot, timeout=self.TIMEOUT)
+        client = self._clients[robot]
+        if speed is None:
+            if robot in self._usual:
+                usual = self._usual.pop(robot)
+                client.update_configuration({"max_vel_x": usual})
+                rospy.loginfo("coordinator: %s navigates at up to %.2f m/s again", robot, usual)
+            return
+        if robot not in self._usual:
+            config = client.get_configuration(timeout=self.TIMEOUT)
+            if config is None:
+                raise RuntimeError("no configuration from /%s/move_base/DWAPlannerROS" % robot)
+            self._usual[robot] = config["max_vel_x"]
+        if speed > self._usual[robot]:
+            client.update_configuration({"max_vel_x": speed})
+            rospy.loginfo("coordinator: %s navigates at up to %.2f m/s through the switch", robot, speed)
 
 
 def _lag(stamps, now):

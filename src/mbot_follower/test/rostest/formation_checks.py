@@ -7,7 +7,8 @@ The check is chosen by the private parameter ~check (one .test file per check):
   triangle  - the triangle drives to (5, 0) via /simulation/target_pose: slot RMS while moving
               < 0.15 m, ARRIVED, no contact (~formation, ~topology: another shape, a chain)
   obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
-  switch    - switch to `line` while moving: the line is reached
+  switch    - switch to `line` while moving: the line is reached; then to `column`: the leader
+              drives faster until the column is there, then at its usual speed again
   loss      - follower_1's controller is killed: DEGRADED within 1 s of the loss, the others ARRIVE
   limit     - max_linear_vel 0.3 on follower_1: its speed stays <= 0.3 m/s while the leader's does not
   corridor  - 4 robots diamond -> column -> diamond through the corridor, no contact
@@ -130,20 +131,39 @@ class FormationChecks(unittest.TestCase):
         slots = [s for s in p.assignment.slots if s.robot != p.assignment.leader]
         self.assertTrue(all(abs(s.offset.x) < 1e-6 for s in slots), "line slots are beside the leader")
 
-        def in_line():
+        def in_slots():
             errors = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
             return errors and max(errors.values()) < 0.3
 
-        t_reached = p.wait(in_line, 60.0, "the followers on their line slots")
+        t_reached = p.wait(in_slots, 60.0, "the followers on their line slots")
         rospy.loginfo("switch: line reached %.1f s after the switch", t_reached - t_switch)
-        self.drive_and_arrive_after_switch()
+        # the followers were behind the line's slots: the leader kept its usual speed
+        usual = rospy.get_param("/%s/move_base/DWAPlannerROS/max_vel_x" % p.status.leader)
+        self.assertLess(self.leader_top_speed(t_switch, t_reached), usual + 0.02)
+
+        # line -> column: both followers are ahead of their new slots, so the leader drives
+        # faster (~switch_leader_vel) until the column is there, then as before
+        t_switch = rospy.get_time()
+        p.formation_pub.publish(String("column"))
+        p.wait(lambda: p.assignment.formation == "column", 5.0, "the column assignment")
+        t_reached = p.wait(in_slots, 60.0, "the followers on their column slots")
+        top = self.leader_top_speed(t_switch, t_reached)
+        rospy.loginfo("switch: column reached %.1f s after the switch, the leader at up to %.2f m/s",
+                      t_reached - t_switch, top)
+        self.assertGreater(top, usual + 0.05)
+        self.drive_and_arrive_after_switch("column")
+        self.assertAlmostEqual(rospy.get_param("/%s/move_base/DWAPlannerROS/max_vel_x" % p.status.leader), usual)
         self.assertNoContacts()
 
-    def drive_and_arrive_after_switch(self):
+    def leader_top_speed(self, since, until):
+        return max(speeds.get(a.leader, 0.0) for (t, _, _, speeds, a) in
+                   self.probe.samples_in(("NAVIGATING", "ARRIVED"), since) if t <= until and a is not None)
+
+    def drive_and_arrive_after_switch(self, formation="line"):
         p = self.probe
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 180.0, "ARRIVED")
         self.assertEqual(p.state(), "ARRIVED", p.status.reason)
-        self.assertEqual(p.status.formation, "line")
+        self.assertEqual(p.status.formation, formation)
         self.leader_at(5.0, 0.0)
 
     def run_loss(self):

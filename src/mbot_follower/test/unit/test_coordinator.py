@@ -435,19 +435,103 @@ def test_after_the_switch_regroup_ends_excused_followers_no_longer_hold_up_the_l
 def test_with_room_ahead_the_leader_drives_through_a_switch_and_waits_only_for_followers_behind():
     core = make()   # no map: room everywhere
     t, poses, _ = formed_and_navigating(core)
-    core.set_formation("column", t, poses)
+    _, _, actions = core.set_formation("column", t, poses)
     # on the triangle's slots (2.17 m behind the leader) the column's slots (2.5 and 5 m) are
-    # behind both followers: the leader driving on brings them closer, so it does not wait
+    # behind both followers: the leader driving on brings them closer, so it does not wait, and
+    # it drives at switch_leader_vel meanwhile
+    assert ("leader_speed", "leader", core.config.switch_leader_vel) in actions
     for i in range(5):
         t += 0.1
         assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == []
     assert "regrouping" not in core.reason
-    # a follower 1 m behind its slot falls further behind while the leader drives: it waits
+    # a follower 1 m behind its slot falls further behind while the leader drives: it waits,
+    # and drives at its usual speed again afterwards
     slots = core.slot_poses(poses)
     late = dict(poses, follower_1=Pose2D(slots["follower_1"].x - 1.0, slots["follower_1"].y, 0.0))
     t += 0.1
-    assert core.update(t, late, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    assert core.update(t, late, heard(t), leader_nav="ACTIVE") == \
+        [("cancel", "leader"), ("leader_speed", "leader", None)]
     assert "follower_1 (1.00 m off its slot)" in core.reason
+    t += 0.1
+    assert core.update(t, at_slots(core, poses["leader"]), heard(t), leader_nav="ACTIVE") == \
+        [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
+
+
+def test_the_leader_drives_fast_through_a_switch_only_until_the_new_shape_is_reached():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    _, _, actions = core.set_formation("column", t, poses)
+    assert actions[-1] == ("leader_speed", "leader", 0.5)
+    leader = poses["leader"]
+    for _ in range(10):  # in the column's slots: stable after stable_time
+        t += 0.1
+        leader = Pose2D(leader.x + 0.05, 0.0, 0.0)
+        actions = core.update(t, at_slots(core, leader), heard(t), leader_nav="ACTIVE")
+        if actions:
+            break
+    assert actions == [("leader_speed", "leader", None)]
+    assert core.events[-1][1] == "switched"
+
+
+def test_a_follower_falling_behind_its_slot_ends_the_fast_switch():
+    # at the robots' top speed a follower behind its slot could not catch up: the leader slows
+    # to its usual speed (no regroup: 0.2 m is below regroup_error), and not faster again
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("column", t, poses)
+    slots = core.slot_poses(poses)
+    behind = dict(poses, follower_2=Pose2D(slots["follower_2"].x - 0.2, slots["follower_2"].y, 0.0))
+    t += 0.1
+    assert core.update(t, behind, heard(t), leader_nav="ACTIVE") == [("leader_speed", "leader", None)]
+    t += 0.1
+    assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == []
+
+
+def test_a_switch_during_the_regroup_of_an_earlier_one_still_drives_fast():
+    # triangle -> line: the leader waits for the followers; still waiting, line -> column
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("line", t, poses)
+    t += 0.1
+    assert core.update(t, poses, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    line = at_slots(core, poses["leader"])
+    core.set_formation("column", t, line)
+    t += 0.1
+    actions = core.update(t, line, heard(t), leader_nav="ACTIVE")
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0)), ("leader_speed", "leader", 0.5)]
+
+
+def test_the_leader_keeps_its_speed_when_followers_are_behind_their_new_slots_or_it_is_off():
+    # triangle -> line: both followers are behind the line's slots (beside the leader)
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    _, _, actions = core.set_formation("line", t, poses)
+    assert not [a for a in actions if a[0] == "leader_speed"]
+    # switch_leader_vel 0 turns it off
+    config = CoordinatorConfig()
+    config.switch_leader_vel = 0.0
+    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, config)
+    t, poses, _ = formed_and_navigating(core)
+    _, _, actions = core.set_formation("column", t, poses)
+    assert not [a for a in actions if a[0] == "leader_speed"]
+
+
+def test_a_pause_or_a_new_leader_ends_the_fast_switch():
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("column", t, poses)
+    t += 0.1
+    actions = core.update(t, poses, heard(t), leader_nav="ACTIVE", obstacle_ahead=True)
+    assert actions == [("cancel", "leader"), ("leader_speed", "leader", None)]
+
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    core.set_formation("column", t, poses)
+    t += core.config.loss_timeout + 0.1
+    alive = {r: p for r, p in poses.items() if r != "leader"}
+    actions = core.update(t, alive, heard(t, ["follower_1", "follower_2"]), leader_nav="ACTIVE")
+    assert core.leader != "leader"
+    assert [a for a in actions if a[0] == "leader_speed"] == [("leader_speed", "leader", None)]
 
 
 def test_before_a_narrow_passage_the_leader_stands_through_a_switch():
