@@ -63,6 +63,19 @@ class Recorder(object):
         raise AssertionError("no message on %s within %.0f s (wall)" % (self.sub.name, wall_timeout))
 
 
+def keep_pace(period=0.05):
+    """Make this test node a pacer of the simulator's lockstep (launched with lockstep:=true): it
+    sends its sim time on /lockstep/heartbeat every `period`, and sim time waits for it. On a
+    busy machine a starved test process would otherwise fall seconds behind: the simulator's
+    publisher queues drop messages it has not read yet, and a robot it drives is stopped by the
+    watchdog between two of its commands."""
+    from std_msgs.msg import Header
+
+    pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10)
+    name = rospy.get_name()
+    return rospy.Timer(rospy.Duration(period), lambda _: pub.publish(Header(stamp=rospy.Time.now(), frame_id=name)))
+
+
 def wait_for_connection(publisher, wall_timeout=10.0):
     end = time.time() + wall_timeout
     while publisher.get_num_connections() == 0 and time.time() < end:

@@ -21,7 +21,7 @@ from sensor_msgs.msg import LaserScan
 from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import (Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
+from sim_test_tools import (keep_pace, Recorder, drive_until, load_pgm_map, map_range,  # noqa: E402
                             publish_for, wait_for_connection, wait_until)
 
 RADIUS = 0.15  # [m] mbot's footprint radius (urdf/mbot.urdf)
@@ -38,6 +38,7 @@ class SimBasics(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_sim_basics")
+        cls.pacer = keep_pace()
         cls.truth = {n: Recorder("/%s/base_pose_ground_truth" % n, Odometry) for n in ("robot_0", "robot_1", "robot_2")}
         cls.scan1 = Recorder("/robot_1/scan", LaserScan)
         cls.contacts = Recorder("/contacts", Contact)

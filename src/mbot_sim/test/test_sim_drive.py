@@ -17,12 +17,13 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import Recorder, wait_for_connection, wait_until  # noqa: E402
+from sim_test_tools import keep_pace, Recorder, wait_for_connection, wait_until  # noqa: E402
 
 
 class SimDrive(unittest.TestCase):
     def test_command_for_two_seconds_drives_one_meter(self):
         rospy.init_node("test_sim_drive")
+        self.pacer = keep_pace()
         self.assertEqual(rospy.get_param("/stage_node/base_watchdog_timeout"), 2.0)
         truth = Recorder("/robot_0/base_pose_ground_truth", Odometry)
         odom = Recorder("/robot_0/odom", Odometry)

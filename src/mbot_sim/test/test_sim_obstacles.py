@@ -20,7 +20,7 @@ from sensor_msgs.msg import LaserScan
 from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import Recorder, load_pgm_map, map_range, wait_until  # noqa: E402
+from sim_test_tools import keep_pace, Recorder, load_pgm_map, map_range, wait_until  # noqa: E402
 
 BOX_X, BOX_Y = 3.5, 2.0              # [m] the box's centre, in front of robot_0
 BOX_LENGTH, BOX_WIDTH = 0.4, 0.6     # [m] its near face is at x = 3.3
@@ -45,6 +45,7 @@ class SimObstacles(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_sim_obstacles")
+        cls.pacer = keep_pace()
         for name in ("spawn_obstacle", "remove_obstacle"):
             rospy.wait_for_service("/" + name, timeout=30.0)
         cls.spawn = rospy.ServiceProxy("/spawn_obstacle", SpawnObstacle)

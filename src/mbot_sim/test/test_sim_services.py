@@ -18,7 +18,7 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import (Recorder, drive_until, publish_for, wait_for_connection,  # noqa: E402
+from sim_test_tools import (keep_pace, Recorder, drive_until, publish_for, wait_for_connection,  # noqa: E402
                             wait_until)
 from mbot_common.waits import wait_for_wall  # noqa: E402
 
@@ -56,6 +56,7 @@ class SimServices(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_sim_services")
+        cls.pacer = keep_pace()
         names = ["spawn_robot", "remove_robot", "teleport_robot", "set_fault", "reset", "reset_positions",
                  "pause_physics", "unpause_physics"]
         for name in names:
