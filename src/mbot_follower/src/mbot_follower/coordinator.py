@@ -41,8 +41,9 @@ shape is there (a column must stand before a corridor). After ``regroup_timeout`
 distance to the slot counts again. When every follower is ahead of (or beside) its new slot as
 such a switch starts, the leader drives at ``switch_leader_vel`` (the robots' top speed, above
 the fleet's usual leader speed) until the new shape is reached: the slots come to the followers
-sooner. The action ``("leader_speed", robot, v)`` asks for that speed, ``v`` None for the usual
-one again; a regroup, a pause, a new leader or a new phase ends it.
+sooner. A follower that falls ``resume_error`` behind its slot ends it (at the robots' top
+speed it could not catch up), as do a regroup, a pause, a new leader or a new phase. The action
+``("leader_speed", robot, v)`` asks for that speed, ``v`` None for the usual one again.
 
 A slot in a wall (a column's last slots behind a leader that starts near a wall, slots behind a
 corner) cannot be held. Its follower is left out of the shape checks (FORMING, a switch,
