@@ -46,6 +46,11 @@ SUCCEEDED = 3              # actionlib_msgs/GoalStatus
 TERMINAL = (2, 3, 4, 5, 8)  # PREEMPTED, SUCCEEDED, ABORTED, REJECTED, RECALLED
 
 
+def round_ended(results, round_goals):
+    """The results [(t, robot, status, goal id)] that ended a goal of `round_goals` (ids)."""
+    return [x for x in results if x[3] in round_goals and x[2] in TERMINAL]
+
+
 def say(text):
     sys.stderr.write("\033[1m[mbot]\033[0m %s\n" % text)
     sys.stderr.flush()
@@ -233,7 +238,7 @@ class ScenarioPlayer(object):
     def __init__(self, scenario, robots, run_dir, screenshots=None, config=None, show_status=True):
         import rospy
         from geometry_msgs.msg import Pose2D as Pose2DMsg, PoseArray
-        from move_base_msgs.msg import MoveBaseActionResult
+        from move_base_msgs.msg import MoveBaseActionGoal, MoveBaseActionResult
 
         from mbot_follower.fleet_probe import FleetProbe
 
@@ -249,10 +254,15 @@ class ScenarioPlayer(object):
         self.Pose2DMsg, self.PoseArray = Pose2DMsg, PoseArray
         self.target_pub = rospy.Publisher("/fleet/target_pose", Pose2DMsg, queue_size=1, latch=True)
         self.dispatch_pub = rospy.Publisher("/dispatch/goals", PoseArray, queue_size=1, latch=True)
-        self.results = []          # (t, robot, status) of every move_base goal that ended
+        self.results = []          # (t, robot, status, goal id) of every move_base goal that ended
+        # The goals of the newest dispatch, by id: a result counts for it only when its goal was
+        # sent after the dispatch. By time alone, the previous round's last result, which set the
+        # dispatch off in the same sim instant, counted for the new round too (ended it early).
+        self.round_goals = set()
         for r in self.robots:
             rospy.Subscriber("/%s/move_base/result" % r, MoveBaseActionResult, self._on_result, callback_args=r,
                              queue_size=20)
+            rospy.Subscriber("/%s/move_base/goal" % r, MoveBaseActionGoal, self._on_goal, queue_size=20)
         self.t0 = None
         self.log = []              # what each step did: {t_s, step, when, action, ok, message}
         self.failed_steps = 0
@@ -275,7 +285,11 @@ class ScenarioPlayer(object):
 
     def _on_result(self, msg, robot):
         with self.probe.lock:
-            self.results.append((self.rospy.get_time(), robot, msg.status.status))
+            self.results.append((self.rospy.get_time(), robot, msg.status.status, msg.status.goal_id.id))
+
+    def _on_goal(self, msg):
+        with self.probe.lock:
+            self.round_goals.add(msg.goal_id.id)
 
     def now(self):
         return self.rospy.get_time() - self.t0
@@ -346,9 +360,10 @@ class ScenarioPlayer(object):
             self.timeline.observe("formed", t)
 
         if self.last_dispatch is not None and not self.goals_done_sent:
-            since, goals = self.last_dispatch
-            ended = [x for x in results if x[0] - self.t0 >= since and x[2] in TERMINAL]
-            if len(ended) >= goals:
+            _, goals = self.last_dispatch
+            with self.probe.lock:
+                round_goals = set(self.round_goals)
+            if len(round_ended(results, round_goals)) >= goals:
                 self.goals_done_sent = True
                 self.timeline.observe("goals_done", t)
 
@@ -456,6 +471,8 @@ class ScenarioPlayer(object):
                 (pose.orientation.x, pose.orientation.y, pose.orientation.z,
                  pose.orientation.w) = quaternion_from_yaw(yaw)
                 msg.poses.append(pose)
+            with self.probe.lock:
+                self.round_goals = set()  # before the dispatcher can send the first of them
             self.dispatch_pub.publish(msg)
             self.dispatched += len(a)
             self.last_dispatch = (t, len(a))
@@ -487,7 +504,7 @@ class ScenarioPlayer(object):
 
     def goals_reached(self):
         with self.probe.lock:
-            return sum(1 for (ts, _, s) in self.results if ts >= self.t0 and s == SUCCEEDED)
+            return sum(1 for (ts, _, s, _) in self.results if ts >= self.t0 and s == SUCCEEDED)
 
     def status_line(self, t):
         p = self.probe
