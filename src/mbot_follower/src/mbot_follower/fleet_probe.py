@@ -6,6 +6,7 @@ stall). What it measures comes from the simulator, not from what the coordinator
 The slots of a formation along the path (a column) are placed on the leader's ground-truth path
 since the assignment (trail.path_slot), like the coordinator and the metrics place them.
 """
+import collections
 import math
 import threading
 import time
@@ -20,6 +21,27 @@ from mbot_common.geometry import Pose2D, yaw_of
 from mbot_follower.trail import Trail, slot_pose
 
 WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
+HISTORY = 50        # ground truth messages kept per robot (1 s at 50 Hz) to align the samples
+SILENT_AFTER = 0.5  # [s sim] a robot whose ground truth is this far behind the newest is gone
+
+
+def aligned(histories):
+    """{robot: (t, pose, speed)} at one instant from each robot's ground truth history (oldest
+    first): the newest entry no later than the oldest of the robots' newest stamps. The
+    simulator stamps every robot's ground truth with the same step times, but the callbacks of
+    a loaded test process run late and in any order: pairing each robot's newest message mixed
+    poses of different times, an error of speed x age (0.35 m/s x 0.5 s) that the fleet never
+    had. A robot silent for SILENT_AFTER (removed) keeps its newest entry."""
+    newest = {r: h[-1] for r, h in histories.items() if h}
+    if not newest:
+        return {}
+    latest = max(e[0] for e in newest.values())
+    live = [r for r, e in newest.items() if e[0] >= latest - SILENT_AFTER]
+    common = min(newest[r][0] for r in live)
+    result = dict(newest)
+    for r in live:
+        result[r] = next((e for e in reversed(histories[r]) if e[0] <= common + 1e-6), histories[r][0])
+    return result
 
 
 class SampledAssignment(object):
@@ -40,7 +62,8 @@ class FleetProbe(object):
     def __init__(self, robots):
         self.lock = threading.RLock()   # slot_errors() takes it, also inside describe()
         self.robots = robots
-        self.truth = {}        # robot -> (t, Pose2D, speed)
+        self.truth = {}        # robot -> (t, Pose2D, speed), the newest
+        self._history = {r: collections.deque(maxlen=HISTORY) for r in robots}
         self.samples = []      # (t, state, {robot: Pose2D}, {robot: speed}, assignment)
         self.status = None
         self.states = []       # (t, state, reason)
@@ -71,6 +94,7 @@ class FleetProbe(object):
         with self.lock:
             pose = Pose2D(p.position.x, p.position.y, yaw_of(p.orientation))
             self.truth[robot] = (msg.header.stamp.to_sec(), pose, math.hypot(v.x, v.y))
+            self._history[robot].append(self.truth[robot])
             if self.assignment is not None and robot == self.assignment.leader:
                 if self._trail_pending:
                     self.trail.start(pose.x, pose.y, pose.theta)
@@ -96,8 +120,9 @@ class FleetProbe(object):
         with self.lock:
             if self.status is None:
                 return
-            poses = {r: v[1] for r, v in self.truth.items()}
-            speeds = {r: v[2] for r, v in self.truth.items()}
+            truth = aligned(self._history)
+            poses = {r: v[1] for r, v in truth.items()}
+            speeds = {r: v[2] for r, v in truth.items()}
             a = self.assignment
             if a is not None:
                 a = SampledAssignment(a, self._slot_poses(poses, a))

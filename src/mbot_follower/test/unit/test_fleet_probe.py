@@ -1,0 +1,36 @@
+"""FleetProbe's samples pair the robots' ground truth of one instant (aligned), not each
+robot's newest message: a loaded test process runs the callbacks late and in any order."""
+import collections
+
+from mbot_common.geometry import Pose2D
+from mbot_follower.fleet_probe import SILENT_AFTER, aligned
+
+
+def history(stamps, x0=0.0, speed=0.35):
+    """A robot driving along x at `speed`: (t, pose, speed) at each stamp."""
+    return collections.deque((t, Pose2D(x0 + speed * t, 0.0, 0.0), speed) for t in stamps)
+
+
+def test_the_robots_are_taken_at_the_newest_instant_all_of_them_have():
+    steps = [round(0.02 * k, 2) for k in range(60)]
+    histories = {"leader": history(steps), "follower": history(steps[:35], x0=-1.5)}  # 0.5 s behind
+    sample = aligned(histories)
+    assert sample["leader"][0] == sample["follower"][0] == steps[34]
+    # the distance the fleet really had, not the leader's newest pose against an old follower's
+    assert abs(sample["leader"][1].x - sample["follower"][1].x - 1.5) < 1e-9
+
+
+def test_a_gap_in_one_history_takes_its_newest_entry_before_that_instant():
+    histories = {"a": history([0.0, 0.02, 0.04, 0.06]), "b": history([0.0, 0.06, 0.08])}
+    assert aligned(histories)["a"][0] == 0.06
+    histories = {"a": history([0.0, 0.02, 0.04, 0.08]), "b": history([0.0, 0.06])}
+    assert aligned(histories)["a"][0] == 0.04
+
+
+def test_a_silent_robot_keeps_its_last_pose_and_does_not_hold_the_others_back():
+    live = [round(0.02 * k, 2) for k in range(100)]
+    histories = {"a": history(live), "b": history(live), "removed": history([0.0, 0.02])}
+    sample = aligned(histories)
+    assert sample["a"][0] == sample["b"][0] == live[-1]
+    assert sample["removed"][0] == 0.02 and live[-1] - 0.02 > SILENT_AFTER
+    assert aligned({}) == {} and aligned({"a": collections.deque()}) == {}
