@@ -268,7 +268,7 @@ class ScenarioPlayer(object):
         self.failed_steps = 0
         self.targets = 0
         self.dispatched = 0        # goals sent in all
-        self.last_dispatch = None  # (t, goals) of the newest dispatch step
+        self.round_size = None     # goals of the newest dispatch step (their ids: round_goals)
         self.pending_shots = []    # (t, name)
         self.awaiting_formation = None
         self.formed_since = None
@@ -359,8 +359,8 @@ class ScenarioPlayer(object):
             self.formed = True
             self.timeline.observe("formed", t)
 
-        if self.last_dispatch is not None and not self.goals_done_sent:
-            _, goals = self.last_dispatch
+        if self.round_size is not None and not self.goals_done_sent:
+            goals = self.round_size
             with self.probe.lock:
                 round_goals = set(self.round_goals)
             if len(round_ended(results, round_goals)) >= goals:
@@ -475,7 +475,7 @@ class ScenarioPlayer(object):
                 self.round_goals = set()  # before the dispatcher can send the first of them
             self.dispatch_pub.publish(msg)
             self.dispatched += len(a)
-            self.last_dispatch = (t, len(a))
+            self.round_size = len(a)
             self.goals_done_sent = False
             self._shot_later(t + 5.0, "dispatch")
             return True, "sent %d goals" % len(a)
