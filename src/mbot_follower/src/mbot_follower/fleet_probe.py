@@ -15,7 +15,7 @@ import rospy
 from geometry_msgs.msg import Pose2D as Pose2DMsg
 from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus, FollowerState
 from nav_msgs.msg import Odometry
-from std_msgs.msg import String
+from std_msgs.msg import Header, String
 
 from mbot_common.geometry import Pose2D, yaw_of
 from mbot_follower.trail import Trail, slot_pose
@@ -59,14 +59,16 @@ class SampledAssignment(object):
 class FleetProbe(object):
     """Records the fleet: ground truth of every robot, status, assignment, contacts."""
 
-    def __init__(self, robots):
+    def __init__(self, robots, pace=False):
+        """pace: send a lockstep heartbeat with every sample, so that the simulator's time waits
+        for this process (a benchmark timing the steps it drives) instead of racing ahead of it."""
         self.lock = threading.RLock()   # slot_errors() takes it, also inside describe()
         self.robots = robots
         self.truth = {}        # robot -> (t, Pose2D, speed), the newest
         self._history = {r: collections.deque(maxlen=HISTORY) for r in robots}
         self.samples = []      # (t, state, {robot: Pose2D}, {robot: speed}, assignment)
         self.status = None
-        self.states = []       # (t, state, reason)
+        self.states = []       # (t, state, reason): t the status message's stamp [s sim]
         self.assignment = None
         self.trail = Trail()   # the leader's ground truth since the assignment (path slots)
         self._trail_pending = False
@@ -82,6 +84,7 @@ class FleetProbe(object):
         self.heartbeats = {}   # robot -> stamp of its controller's last state [s sim]
         self._state_subs = {r: rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
                                                 self._on_follower, queue_size=5) for r in robots}
+        self._heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10) if pace else None
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
 
     def _on_follower(self, msg):
@@ -104,7 +107,9 @@ class FleetProbe(object):
     def _on_status(self, msg):
         with self.lock:
             if self.status is None or msg.state != self.status.state:
-                self.states.append((rospy.get_time(), msg.state, msg.reason))
+                # the coordinator's stamp: a loaded process runs this callback late
+                t = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else rospy.get_time()
+                self.states.append((t, msg.state, msg.reason))
             self.status = msg
 
     def _on_assignment(self, msg):
@@ -116,7 +121,9 @@ class FleetProbe(object):
         with self.lock:
             self.contacts.append(msg)
 
-    def _sample(self, _event):
+    def _sample(self, event):
+        if self._heartbeat_pub is not None:
+            self._heartbeat_pub.publish(Header(stamp=event.current_real, frame_id=rospy.get_name()))
         with self.lock:
             if self.status is None:
                 return

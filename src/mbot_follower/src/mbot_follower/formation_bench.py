@@ -10,7 +10,7 @@ One run (one fleet size, one seed) in ``field``, an empty 40 x 40 m room:
 2. the leader drives east: **rms_straight_m**, the followers' slot error RMS while the leader
    moves (>= 0.1 m/s), from 3 s after it set off until the switch;
 3. when the leader passes x = -2 the formation switches to ``column`` on the move:
-   **switch_s**, the time until every follower is within 0.3 m of its new slot;
+   **switch_s**, from the switch until every follower is within 0.3 m of its new slot;
 4. at the target the first formation again, then a route with two 90 degree turns, (4, 4) and
    (-10, 4): **rms_route_m**, measured as in 2 over both legs;
 5. on the way to (-10, -6) one follower's controller is killed: **degraded_s**, the time to
@@ -18,6 +18,11 @@ One run (one fleet size, one seed) in ``field``, an empty 40 x 40 m room:
    below 0.15 m for 1 s (both timed from the controller's last message: a loss is 1 s of silence);
 6. **contacts** (from the simulator) and **cycle_p99_ms** (the controllers' cycle time, wall)
    from the metrics collector.
+
+The times (converge, switch, DEGRADED, recover) are read after the run from the metrics
+collector's record (``timings``): it stamps every sample and event with the sim time of the data,
+and it is a lockstep pacer. The probe that drives the steps is not, and on a loaded machine it
+notices a condition late while sim time runs on (a switch of 4.35 s read as 6.1 s).
 
 The formation is ``diamond`` (``triangle`` for 3 robots: a diamond needs 4), spacing 1.5 m.
 A row of the table is the worst value over the seeds; ``succeeded`` counts runs in which every
@@ -94,17 +99,59 @@ def worst(runs):
     return row
 
 
+SWITCH_TOLERANCE = 0.3          # [m] every follower this close to its new slot: switched
+
+
+def timings(run):
+    """converge_s, switch_s, degraded_s, recover_s [s] from a metrics collector's Run (its
+    events, samples and controller cycles carry the data's sim time); None where the record
+    lacks the step. The loss is timed from the killed controller's last cycle."""
+    from mbot_follower.metrics import recoveries
+
+    events = sorted(run.events, key=lambda e: e.t)
+    out = {"converge_s": None, "switch_s": None, "degraded_s": None, "recover_s": None}
+    forming = next((e.t for e in events if e.kind == "state" and e.name == "FORMING"), None)
+    if forming is not None:
+        navigating = next((e.t for e in events if e.kind == "state" and e.name == "NAVIGATING"
+                           and e.t >= forming), None)
+        if navigating is not None:
+            out["converge_s"] = round(navigating - forming, 2)
+    switch = next((e.t for e in events if e.kind == "switch" and e.name == "column"), None)
+    if switch is not None:
+        formed = next((s.t for s in run.samples if s.t >= switch and s.formation == "column"
+                       and s.slot_max < SWITCH_TOLERANCE), None)
+        if formed is not None:
+            out["switch_s"] = round(formed - switch, 2)
+    loss = next((e for e in events if e.kind == "loss"), None)
+    victim = loss.name if loss else None
+    loss = loss.t if loss else None
+    killed = max((c.t for c in run.controller if c.robot == victim and c.t <= loss), default=None) if loss else None
+    if killed is not None:
+        # re-planned: the first assignment from the loss on without the victim in a slot
+        replanned = next((e.t for e in events if e.kind == "assignment" and e.t >= loss
+                          and " %s(" % victim not in " " + e.detail.split("slots", 1)[-1]), None)
+        if replanned is not None:
+            out["degraded_s"] = round(replanned - killed, 2)
+        recovered = next((r["recovery_time_s"] for r in recoveries(run)
+                          if r["robot"] == victim and r["t_s"] == loss), None)
+        if recovered is not None:
+            out["recover_s"] = round(loss + recovered - killed, 2)
+    return out
+
+
 # --- one run (child process) -----------------------------------------------------------------
 
 def drive(n, seed, log):
-    """Play the steps of one run against the fleet already launched; returns the measures."""
+    """Play the steps of one run against the fleet already launched; returns the measures the
+    probe takes (slot RMS, contacts); the times come from the record afterwards (`timings`)."""
     import rospy
     from std_msgs.msg import String
+    from std_srvs.srv import Empty
 
     from mbot_follower.fleet_probe import FleetProbe
 
     robots = ["robot_%d" % i for i in range(n)]
-    probe = FleetProbe(robots)
+    probe = FleetProbe(robots, pace=True)
     probe.wait_for_fleet(wall_timeout=300.0)
     result = {"n": n, "seed": seed, "succeeded": False}
     first = formation_for(n)
@@ -127,23 +174,16 @@ def drive(n, seed, log):
         errors = probe.slot_errors({r: v[1] for r, v in probe.truth.items()}, probe.assignment)
         return bool(errors) and max(errors.values()) < tolerance
 
-    def state_time(state, after):
-        return next(t for (t, s, _) in probe.states if s == state and t >= after)
-
     # 1-2: converge from the random starts, then straight east
-    t0 = rospy.get_time()
     probe.send_target(4.0, -10.0, 0.0)
     t_nav = probe.wait(lambda: probe.state() == "NAVIGATING", 120.0, "the end of FORMING")
-    result["converge_s"] = round(t_nav - t0, 2)
     probe.wait(lambda: probe.truth["robot_0"][1].x > -2.0, 300.0, "the leader at x = -2")
     result["rms_straight_m"] = moving_rms(t_nav + 3.0, rospy.get_time())
-    log("n=%d seed=%d: converged in %.1f s, straight RMS %.3f m"
-        % (n, seed, result["converge_s"], result["rms_straight_m"] or -1))
+    log("n=%d seed=%d: formed, straight RMS %.3f m" % (n, seed, result["rms_straight_m"] or -1))
     # 3: switch to a column on the move
-    t_switch = rospy.get_time()
     probe.formation_pub.publish(String("column"))
     probe.wait(lambda: probe.assignment is not None and probe.assignment.formation == "column", 10.0, "column")
-    result["switch_s"] = round(probe.wait(lambda: formed(0.3), 60.0, "the column") - t_switch, 2)
+    probe.wait(lambda: formed(SWITCH_TOLERANCE), 60.0, "the column")
     probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, "the straight run")
     if probe.state() != "ARRIVED":
         raise RuntimeError("the straight run: %s (%s)" % (probe.state(), probe.status.reason))
@@ -159,15 +199,18 @@ def drive(n, seed, log):
     probe.send_target(-10.0, -6.0, -math.pi / 2)
     probe.wait(lambda: probe.state() == "NAVIGATING" and probe.truth["robot_0"][1].y < 2.0, 120.0, "the last leg")
     victim = sorted(s.robot for s in probe.assignment.slots if s.robot != probe.assignment.leader)[-1]
-    t_kill = rospy.get_time()  # before: sim time goes on while rosnode kill runs
-    subprocess.check_call(["rosnode", "kill", "/%s/follower_controller" % victim],
-                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # paused: on a loaded machine `rosnode kill` takes wall seconds, and the fleet must not reach
+    # its target meanwhile (a slot beside the dead robot stays blocked where the leader stops)
+    rospy.ServiceProxy("/pause_physics", Empty)()
+    try:
+        subprocess.check_call(["rosnode", "kill", "/%s/follower_controller" % victim],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    finally:
+        rospy.ServiceProxy("/unpause_physics", Empty)()
     # the loss shows in `lost` (the state may read ARRIVED if the leader got there meanwhile)
-    t_degraded = probe.wait(lambda: victim in probe.status.lost and victim not in
-                            [s.robot for s in probe.assignment.slots], 30.0, "DEGRADED")
-    # the loss happened when the controller fell silent (sim time runs on while rosnode kill works)
-    t_kill = max(t_kill, probe.last_heard(victim))
-    result["degraded_s"] = round(t_degraded - t_kill, 2)
+    probe.wait(lambda: victim in probe.status.lost and victim not in
+               [s.robot for s in probe.assignment.slots], 30.0, "DEGRADED")
+    result["victim"] = victim
     held = []
 
     def reconverged():
@@ -181,7 +224,7 @@ def drive(n, seed, log):
             held.append(now)
         return ok and now - held[0] >= 1.0
 
-    result["recover_s"] = round(probe.wait(reconverged, 60.0, "re-converged") - 1.0 - t_kill, 2)
+    probe.wait(reconverged, 60.0, "re-converged")
     probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, "the last leg")
     result["contacts"] = len(probe.contacts)
     result["succeeded"] = probe.state() == "ARRIVED"
@@ -224,10 +267,24 @@ def run_one(n, seed, out_dir, log):
         stop(process, log)
     metrics = os.path.join(run_dir, "metrics", "metrics.json")
     if os.path.exists(metrics):
+        from mbot_follower.metrics import RunFileError, load_run
+
         with open(metrics) as f:
             fleet = json.load(f)["fleet"]
         result["cycle_p99_ms"] = fleet.get("cycle_time_p99_ms")
         result["contacts"] = max(result.get("contacts", 0), fleet.get("contacts") or 0)
+        try:
+            result.update(timings(load_run(os.path.dirname(metrics))))
+        except RunFileError as error:
+            result["error"] = "the metrics record: %s" % error
+            result["succeeded"] = False
+        missing = [k for k in ("converge_s", "switch_s", "degraded_s", "recover_s") if result.get(k) is None]
+        if result.get("succeeded") and missing:
+            result["error"] = "the metrics record lacks %s" % ", ".join(missing)
+            result["succeeded"] = False
+    elif result.get("succeeded"):
+        result["error"] = "no metrics record in %s" % os.path.dirname(metrics)
+        result["succeeded"] = False
     return result
 
 
