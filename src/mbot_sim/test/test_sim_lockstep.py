@@ -8,7 +8,7 @@ boundary, so while the test drives, sim time never gets more than one period (+ 
 for a boundary between two steps) past the last boundary the test answered. Without lockstep sim time
 runs seconds ahead within the 20 ms.
 When the test stops sending, robot_0 is no longer waited for: sim time runs on (> 5 s sim within
-a few wall seconds), it does not hang.
+10 wall seconds: one 3 s wall timeout, then free), it does not hang.
 
 A slow localization for robot_1 (not driven) holds sim time the same way: it answers each boundary
 20 ms late with map -> robot_1/odom stamped at that boundary, and sim time never gets more than
@@ -101,9 +101,9 @@ def answer_boundaries(watch, period, answer, warm_up=0):
 
 
 def wait_for_release(watch, what):
-    """After the slow node stopped: one wall timeout later sim time runs on (5 s sim in < 5 s wall)."""
+    """After the slow node stopped: one wall timeout (3 s) later sim time runs on (5 s sim in < 10 s wall)."""
     t0, w0 = watch.now(), time.time()
-    wait_for(lambda: watch.now() > t0 + 5.0, 5.0, "sim time to run 5 s on after %s stopped" % what)
+    wait_for(lambda: watch.now() > t0 + 5.0, 10.0, "sim time to run 5 s on after %s stopped" % what)
     print("after the stop: 5 s sim in %.2f s wall" % (time.time() - w0))
 
 
