@@ -18,6 +18,7 @@ from nav_msgs.msg import Odometry
 from std_msgs.msg import Header, String
 
 from mbot_common.geometry import Pose2D, yaw_of
+from mbot_follower.metrics_node import stamp_of
 from mbot_follower.trail import Trail, slot_pose
 
 WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
@@ -108,8 +109,7 @@ class FleetProbe(object):
         with self.lock:
             if self.status is None or msg.state != self.status.state:
                 # the coordinator's stamp: a loaded process runs this callback late
-                t = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else rospy.get_time()
-                self.states.append((t, msg.state, msg.reason))
+                self.states.append((stamp_of(msg.header), msg.state, msg.reason))
             self.status = msg
 
     def _on_assignment(self, msg):

@@ -123,19 +123,21 @@ def timings(run):
         if formed is not None:
             out["switch_s"] = round(formed - switch, 2)
     loss = next((e for e in events if e.kind == "loss"), None)
-    victim = loss.name if loss else None
-    loss = loss.t if loss else None
-    killed = max((c.t for c in run.controller if c.robot == victim and c.t <= loss), default=None) if loss else None
-    if killed is not None:
-        # re-planned: the first assignment from the loss on without the victim in a slot
-        replanned = next((e.t for e in events if e.kind == "assignment" and e.t >= loss
-                          and " %s(" % victim not in " " + e.detail.split("slots", 1)[-1]), None)
-        if replanned is not None:
-            out["degraded_s"] = round(replanned - killed, 2)
-        recovered = next((r["recovery_time_s"] for r in recoveries(run)
-                          if r["robot"] == victim and r["t_s"] == loss), None)
-        if recovered is not None:
-            out["recover_s"] = round(loss + recovered - killed, 2)
+    if loss is None:
+        return out
+    victim = loss.name
+    killed = max((c.t for c in run.controller if c.robot == victim and c.t <= loss.t), default=None)
+    if killed is None:
+        return out
+    # re-planned: the first assignment from the loss on without the victim in a slot
+    replanned = next((e.t for e in events if e.kind == "assignment" and e.t >= loss.t
+                      and " %s(" % victim not in " " + e.detail.split("slots", 1)[-1]), None)
+    if replanned is not None:
+        out["degraded_s"] = round(replanned - killed, 2)
+    recovered = next((r["recovery_time_s"] for r in recoveries(run)
+                      if r["robot"] == victim and r["t_s"] == loss.t), None)
+    if recovered is not None:
+        out["recover_s"] = round(loss.t + recovered - killed, 2)
     return out
 
 
