@@ -250,6 +250,51 @@ def test_a_slot_beside_a_lost_robot_standing_there_is_not_waited_for():
     assert core.blocked == [] and "waits for %s" % other in core.reason
 
 
+def test_while_a_slot_beside_a_lost_robot_is_blocked_the_leader_waits_for_nobody():
+    """A diamond of 5 loses a front follower standing in its slot. The diamond of 4 has a slot
+    there too: the rear neighbour on that side gets it (blocked, beside the dead robot), and the
+    other rear robot's slot, the middle one, lies 0.53 m beside that held neighbour, which it
+    cannot pass. Only the leader driving on frees both: it must not wait, and a regroup under
+    way ends (benchmark seeds 2 and 8 waited 8 and 19 s for the middle slot before)."""
+    robots = ["leader", "follower_1", "follower_2", "follower_3", "follower_4"]
+    core = FleetCoordinator(robots, "leader", "diamond", 1.5, CoordinatorConfig())
+    poses = {r: Pose2D(-1.0 * i, 2.0 * (i % 2) - 1.0, 0.0) for i, r in enumerate(robots)}
+    core.set_goal(Pose2D(9.0, 0.0, 0.0), 0.0, poses)
+    t, leader = 0.0, Pose2D(0.0, 0.0, 0.0)
+    while core.phase == FORMING and t < 2.0:
+        t += 0.1
+        poses = at_slots(core, leader)
+        core.update(t, poses, heard(t, robots))
+    assert core.phase == NAVIGATING
+    slots = core.assignment.slots
+    dead = [r for r in robots if slots[r][0] == pytest.approx(-1.06066, abs=1e-4) and slots[r][1] < 0][0]
+    left_rear, right_rear = sorted((r for r in robots if slots[r][0] < -2.0), key=lambda r: -slots[r][1])
+    # a regroup is under way: the left rear follower lags 0.5 m
+    off = dict(poses)
+    off[left_rear] = Pose2D(poses[left_rear].x - 0.5, poses[left_rear].y, 0.0)
+    t += 0.1
+    assert core.update(t, off, heard(t, robots), leader_nav="ACTIVE") == [("cancel", "leader")]
+    last, actions = heard(t, robots), []
+    for i in range(12):
+        t += 0.1
+        last.update({r: t for r in robots if r != dead})
+        actions += core.update(t, off, last, leader_nav=None)
+    assert core.lost == [dead]
+    slots = core.assignment.slots
+    assert slots[right_rear] == pytest.approx((-1.06066, -1.06066), abs=1e-4)  # the dead robot's slot
+    assert slots[left_rear] == pytest.approx((-2.12132, 0.0), abs=1e-4)
+    assert core.blocked == [right_rear] and "beside the lost %s" % dead in core.reason
+    errors = core.slot_errors(off)
+    assert errors[left_rear][0] > core.config.regroup_error and errors[right_rear][0] > 1.0
+    assert actions[-1] == ("goal", "leader", Pose2D(9.0, 0.0, 0.0)) and actions.count(("cancel", "leader")) == 0
+    # while the slot stays blocked, no new regroup
+    for i in range(20):
+        t += 0.1
+        last.update({r: t for r in robots if r != dead})
+        assert core.update(t, off, last, leader_nav="ACTIVE") == [], core.reason
+    assert core.blocked == [right_rear]
+
+
 def test_a_lost_leader_is_replaced_by_the_follower_nearest_its_slot():
     core = make()
     t, poses, _ = formed_and_navigating(core)
