@@ -211,21 +211,28 @@ def test_a_silent_follower_is_lost_and_the_rest_replanned_then_it_rejoins():
     assert "follower_1" in core.assignment.slots
 
 
+def diamond_of_5_navigating():
+    """A diamond of 5 (spacing 1.5 m) formed at the origin and navigating to (9, 0): (core, t, poses)."""
+    robots = ["leader", "follower_1", "follower_2", "follower_3", "follower_4"]
+    core = FleetCoordinator(robots, "leader", "diamond", 1.5, CoordinatorConfig())
+    poses = {r: Pose2D(-1.0 * i, 2.0 * (i % 2) - 1.0, 0.0) for i, r in enumerate(robots)}
+    core.set_goal(Pose2D(9.0, 0.0, 0.0), 0.0, poses)
+    t = 0.0
+    while core.phase == FORMING and t < 2.0:
+        t += 0.1
+        poses = at_slots(core, Pose2D(0.0, 0.0, 0.0))
+        core.update(t, poses, heard(t, robots))
+    assert core.phase == NAVIGATING
+    return core, t, poses
+
+
 def test_a_slot_beside_a_lost_robot_standing_there_is_not_waited_for():
     """A diamond of 5 loses a rear follower whose robot stands still in its slot (its controller
     died). In the diamond of 4 the other rear follower's slot is the middle one, 0.53 m beside the
     dead robot, where its safety layer stops it: the leader does not wait for it until the slot
     has been clear of the dead robot for free_hold (benchmark seed 4: 15 s of waiting before)."""
-    robots = ["leader", "follower_1", "follower_2", "follower_3", "follower_4"]
-    core = FleetCoordinator(robots, "leader", "diamond", 1.5, CoordinatorConfig())
-    poses = {r: Pose2D(-1.0 * i, 2.0 * (i % 2) - 1.0, 0.0) for i, r in enumerate(robots)}
-    core.set_goal(Pose2D(9.0, 0.0, 0.0), 0.0, poses)
-    t, leader = 0.0, Pose2D(0.0, 0.0, 0.0)
-    while core.phase == FORMING and t < 2.0:
-        t += 0.1
-        poses = at_slots(core, leader)
-        core.update(t, poses, heard(t, robots))
-    assert core.phase == NAVIGATING
+    core, t, poses = diamond_of_5_navigating()
+    robots = list(poses)
     rear = sorted((r for r in robots if core.assignment.slots[r][0] < -2.0), key=lambda r: core.assignment.slots[r][1])
     dead, other = rear  # the rear right corner (y < 0) dies, the rear left one stays
     last, actions = heard(t, robots), []
@@ -256,16 +263,8 @@ def test_while_a_slot_beside_a_lost_robot_is_blocked_the_leader_waits_for_nobody
     other rear robot's slot, the middle one, lies 0.53 m beside that held neighbour, which it
     cannot pass. Only the leader driving on frees both: it must not wait, and a regroup under
     way ends (benchmark seeds 2 and 8 waited 8 and 19 s for the middle slot before)."""
-    robots = ["leader", "follower_1", "follower_2", "follower_3", "follower_4"]
-    core = FleetCoordinator(robots, "leader", "diamond", 1.5, CoordinatorConfig())
-    poses = {r: Pose2D(-1.0 * i, 2.0 * (i % 2) - 1.0, 0.0) for i, r in enumerate(robots)}
-    core.set_goal(Pose2D(9.0, 0.0, 0.0), 0.0, poses)
-    t, leader = 0.0, Pose2D(0.0, 0.0, 0.0)
-    while core.phase == FORMING and t < 2.0:
-        t += 0.1
-        poses = at_slots(core, leader)
-        core.update(t, poses, heard(t, robots))
-    assert core.phase == NAVIGATING
+    core, t, poses = diamond_of_5_navigating()
+    robots = list(poses)
     slots = core.assignment.slots
     dead = [r for r in robots if slots[r][0] == pytest.approx(-1.06066, abs=1e-4) and slots[r][1] < 0][0]
     left_rear, right_rear = sorted((r for r in robots if slots[r][0] < -2.0), key=lambda r: -slots[r][1])
