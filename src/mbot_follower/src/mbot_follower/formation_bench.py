@@ -122,7 +122,10 @@ def timings(run):
                        and s.slot_max < SWITCH_TOLERANCE), None)
         if formed is not None:
             out["switch_s"] = round(formed - switch, 2)
-    loss = next((e for e in events if e.kind == "loss"), None)
+    # the kill: a loss for good. A robot lost for a moment (its controller starved on a busy
+    # machine, as the fleet starts) rejoins, and that loss is not the one measured.
+    loss = next((e for e in events if e.kind == "loss" and not any(
+        r.kind == "rejoin" and r.name == e.name and r.t >= e.t for r in events)), None)
     if loss is None:
         return out
     victim = loss.name

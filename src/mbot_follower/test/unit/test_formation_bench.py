@@ -63,6 +63,17 @@ def test_the_loss_is_timed_from_the_victims_last_cycle_before_it():
     assert timings(run)["degraded_s"] is None and timings(run)["recover_s"] is None
 
 
+def test_a_robot_lost_for_a_moment_and_back_is_not_the_loss_measured():
+    # a follower's controller starved as the fleet starts: lost at 5.0 s, back at 5.4 s
+    run = recorded_run()
+    startup = [event(5.0, "loss", "robot_2"),
+               event(5.0, "assignment", "wedge", "leader robot_0 slots robot_0(0,0) robot_1(-1,1)"),
+               event(5.4, "rejoin", "robot_2")]
+    run.events[:0] = startup
+    run.controller.insert(0, ControllerSample(3.6, "robot_2", 0.02, 5.0, 0, 0, "slot"))
+    assert timings(run) == timings(recorded_run())
+
+
 def test_a_step_missing_from_the_record_reads_none():
     run = recorded_run()
     run.events = [e for e in run.events if e.kind not in ("loss", "switch")]
