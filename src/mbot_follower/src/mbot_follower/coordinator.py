@@ -90,6 +90,8 @@ IDLE, FORMING, NAVIGATING, ARRIVED, DEGRADED, ABORTED = (
     "IDLE", "FORMING", "NAVIGATING", "ARRIVED", "DEGRADED", "ABORTED")
 #: When the robots left cannot take the formation (a diamond of 3), the first of these that fits.
 FALLBACK_FORMATIONS = ("triangle", "wedge", "column")
+#: How blocked_followers() names a slot blocked by a lost robot standing there (_regroup reads it).
+BESIDE_LOST = "beside the lost "
 
 
 class CoordinatorConfig(object):
@@ -359,7 +361,7 @@ class FleetCoordinator(object):
         excused = set(excused) | set(self.blocked)
         errors = {r: e for r, e in self._regroup_errors(now, poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
-        beside_lost = [r for r in self.blocked if self._blocked_by[r].startswith("beside the lost")]
+        beside_lost = [r for r in self.blocked if self._blocked_by[r].startswith(BESIDE_LOST)]
         if beside_lost:
             # only driving on frees a slot beside a dead robot, and whoever waits behind its follower
             worst = None
@@ -381,7 +383,7 @@ class FleetCoordinator(object):
         if beside_lost:
             held = beside_lost[0]
             self.reason = "driving on: only that frees %s's slot, %s" % (held, self._blocked_by[held])
-        elif timed_out:
+        elif timed_out and worst is not None:  # (None: every follower excused at the last moment)
             self.reason = "driving on after %.0f s of regrouping (%s %.2f m off its slot)" % (
                 self.config.regroup_timeout, worst[0], worst[1])
         else:
@@ -571,7 +573,7 @@ class FleetCoordinator(object):
             near = [lost for lost, p in standing
                     if math.hypot(p.x - slot.x, p.y - slot.y) < self.config.lost_clearance]
             if near:
-                result[r] = "beside the lost %s" % near[0]
+                result[r] = BESIDE_LOST + near[0]
         return result
 
     def _blocked_text(self):

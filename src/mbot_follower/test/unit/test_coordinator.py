@@ -430,6 +430,23 @@ def test_regrouping_gives_up_after_its_timeout():
     assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == []   # not again at once
 
 
+def test_a_regroup_that_times_out_as_every_follower_becomes_excused_drives_on():
+    # the excuses count (held excuse_time) in the same cycle as the timeout: nobody is left to
+    # name in the reason (this raised a TypeError)
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = {r: Pose2D(p.x - 1.0, p.y, p.theta) if r != "leader" else p for r, p in poses.items()}
+    t0 = t + 0.1
+    assert core.update(t0, off, heard(t0), leader_nav="ACTIVE") == [("cancel", "leader")]
+    actions, t = [], t0
+    while not actions:
+        t += 0.1
+        excused = ["follower_1", "follower_2"] if t > t0 + core.config.regroup_timeout - 1.1 else []
+        actions = core.update(t, off, heard(t), excused=excused)
+    assert t - t0 > core.config.regroup_timeout
+    assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))] and "driving on" in core.reason
+
+
 def test_the_leader_left_alone_keeps_its_goal_and_the_others_rejoin():
     core = make()
     t, poses, _ = formed_and_navigating(core)
