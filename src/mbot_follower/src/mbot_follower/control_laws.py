@@ -45,7 +45,10 @@ s = (s_x, s_y) of L; the leader moves with the twist (v_L, w_L) in its own body 
    centimetres. Backing up fast is never done: a diff-drive robot cannot see behind it.
 
 4. CommandFilter smooths the command, limits the acceleration, then the velocity. safety_stop
-   says when the laser sees something too close ahead. energy_rate is the power model.
+   says when the laser sees something too close ahead. way_blocked says when something stands
+   on the straight way to the slot, and detour finds the smallest turn of that way that is
+   clear (the follower steers round the obstacle instead of stopping behind it). energy_rate is
+   the power model.
 
 Run `python3 -m mbot_follower.control_laws --plot` to watch a leader drive a curve with two
 followers. Pure Python + numpy, no ROS: the ROS node only converts messages.
@@ -311,6 +314,49 @@ def safety_filter(cmd, ranges, angle_min, angle_increment, config):
                          config.safety_lane_half_width):
         return Twist2D(0.0, 0.0, cmd.wz), True
     return cmd, False
+
+
+def scan_points(ranges, angle_min, angle_increment, range_min, reach):
+    """The laser's finite readings from `range_min` to `reach` [m] as points (x, y) of the
+    robot's frame."""
+    points = []
+    for i, r in enumerate(ranges):
+        if range_min <= r <= reach:
+            a = angle_min + i * angle_increment
+            points.append((r * math.cos(a), r * math.sin(a)))
+    return points
+
+
+def way_blocked(points, gx, gy, horizon, clearance):
+    """True when a point lies closer than `clearance` [m] to the straight way from the robot
+    (the origin) towards (gx, gy), over its first `horizon` [m]."""
+    length = math.hypot(gx, gy)
+    if length < 1e-6:
+        return False
+    ux, uy = gx / length, gy / length
+    horizon = min(length, horizon)
+    for px, py in points:
+        along = px * ux + py * uy
+        if 0.0 <= along <= horizon and abs(py * ux - px * uy) < clearance:
+            return True
+    return False
+
+
+def detour(points, gx, gy, horizon, clearance, step, max_turn, prefer=1, is_free=None):
+    """A way round something standing between the robot and its goal (gx, gy), both in the
+    robot's frame: ((x, y), side), the goal turned about the robot by the smallest multiple of
+    `step` [rad], to either side up to `max_turn`, whose straight way way_blocked finds clear
+    (and is_free(x, y), if given, accepts). Of two equal turns the one to side `prefer`
+    (+1 left, -1 right) comes first, so that a robot keeps to the side it chose. None if no way
+    is clear."""
+    turns = int(max_turn / step + 1e-9)
+    for k in range(1, turns + 1):
+        for side in (prefer, -prefer):
+            c, s = math.cos(side * k * step), math.sin(side * k * step)
+            x, y = c * gx - s * gy, s * gx + c * gy
+            if not way_blocked(points, x, y, horizon, clearance) and (is_free is None or is_free(x, y)):
+                return (x, y), side
+    return None
 
 
 class GiveWay(object):

@@ -11,8 +11,11 @@ Every control period (sim time) it
    failures are counted and published;
 3. picks its target: its slot from ``/fleet/assignment`` (for a formation along the path, a
    column, the point of the leader's path its slot's distance behind the leader, from the
-   leader's map positions recorded since the assignment: trail.path_slot), or, when the slot
-   or the straight way to it is blocked (a wall, its inflation, something the laser sees), a
+   leader's map positions recorded since the assignment: trail.path_slot); or, when something
+   only the laser sees (a robot, an obstacle) stands on the straight way to a rigid slot, a way
+   round it (mode ``detour``: the way to the slot turned by the smallest multiple of
+   ``~detour_step`` that is clear, control_laws.detour); or, when the slot or the way to it is
+   blocked otherwise (a wall, its inflation, no clear way round), a
    point on the leader's recent path (the trail) ``~trail_lookahead`` ahead of where the
    follower is on it, but no nearer the leader than the slot is: a path the leader drove is
    free, also around corners and through doors, and the follower rejoins its slot once the way
@@ -40,8 +43,8 @@ import time
 import rospy
 
 from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
-from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, energy_rate,
-                                        make_control_law, safety_filter)
+from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, detour,
+                                        energy_rate, make_control_law, safety_filter, scan_points, way_blocked)
 from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.merge import merge_target, robot_ahead
@@ -57,6 +60,8 @@ NODE_PARAMS = {
     "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
     "scan_clearance": 0.35,   # a laser point closer than this to the way to the slot blocks it [m]
     "scan_horizon": 2.0,      # how far along the way to the slot the laser check looks [m]
+    "detour_step": math.radians(15),      # a way round an obstacle turns in steps of this [rad]
+    "detour_max_turn": math.radians(90),  # ... at most this far from the way to the slot [rad]
     "trail_lookahead": 0.6,   # on the trail, drive to the point this far ahead on it [m]
     "path_turn_window": 0.2,  # a path slot turns as the path does over this much path ahead of it [m]
     "merge_lane": 0.7,        # a column follower waits this far beside the path for its turn [m]
@@ -89,6 +94,7 @@ class FollowerController(object):
         self.filter = CommandFilter(self.config)
         self.give_way = GiveWay()
         self._held = False
+        self._detour_side = 1              # the side of the last way round an obstacle (+1 left)
 
         self.assignment = None
         self.fleet_state = "IDLE"
@@ -229,13 +235,14 @@ class FollowerController(object):
         self._record_trail(a, reference, ref_map, now)
         frame, pose, slot, frame_twist = self._slot_frame(a, reference, pose, ref_map)
         goal, merging = self._merge_goal(a, now, frame, pose, slot) if frame is not ref_map else (slot, False)
-        target, mode = self._target(goal, pose, frame, math.hypot(*a.slots[self.robot]), scan_check=not merging)
+        target, mode = self._target(goal, pose, frame, math.hypot(*a.slots[self.robot]), scan_check=not merging,
+                                    rigid=frame is ref_map)
         if merging and mode == "slot":
             mode = "merge"
         neighbours = []
         if self.params["controller"] == "consensus":
             neighbours = self._neighbours(a, now) if frame is ref_map else self._path_neighbours(a, now, frame)
-        twist = frame_twist if mode in ("slot", "merge") else Twist2D(frame_twist.vx, 0.0, 0.0)
+        twist = frame_twist if mode in ("slot", "merge", "detour") else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
         if self.scan is not None:
@@ -323,21 +330,31 @@ class FollowerController(object):
         rx, ry = a.slots[reference]
         return sx - rx, sy - ry
 
-    def _target(self, slot, pose, ref_map, behind_leader, scan_check=True):
-        """(target in the reference robot's frame, mode): the slot, or the trail point when the
-        slot or the way to it is blocked. The trail is the leader's: in a chain the point is
-        `behind_leader` (the slot's distance from the leader) back on it, not the distance from
-        the robot ahead. A follower waiting beside a column's path (merging) does not check its
-        way with the laser: the robots it sees in its lane it waits for, and the trail would take
-        it onto the path out of turn."""
+    def _target(self, slot, pose, ref_map, behind_leader, scan_check=True, rigid=True):
+        """(target in the reference robot's frame, mode): the slot; or, when something only the
+        laser sees stands on the straight way to a rigid slot (a robot, an obstacle), a way round
+        it (mode detour); or, when the slot or the way to it is blocked otherwise (a wall of the
+        map, or no way round), the trail point. The trail is the leader's: in a chain the point
+        is `behind_leader` (the slot's distance from the leader) back on it, not the distance
+        from the robot ahead. A follower waiting beside a column's path (merging) does not check
+        its way with the laser: the robots it sees in its lane it waits for, and the trail would
+        take it onto the path out of turn. A column's follower (not rigid) keeps to the trail,
+        its slot's own path, rather than steer off it round the robot ahead."""
         slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
         me_map = compose(ref_map, pose)
         blocked = False
         if self.free_space is not None:
             blocked = not self.free_space.is_free(slot_map.x, slot_map.y) or not self.free_space.segment_free(
                 me_map.x, me_map.y, slot_map.x, slot_map.y)
-        if not blocked and scan_check:
-            blocked = self._scan_blocks(pose, slot)
+        if not blocked and scan_check and self.scan is not None:
+            goal = relative(pose, Pose2D(slot[0], slot[1], 0.0))   # the slot in the robot's own frame
+            points = self._scan_points()
+            blocked = way_blocked(points, goal.x, goal.y, self.params["scan_horizon"], self.params["scan_clearance"])
+            if blocked and rigid:
+                way = self._detour(points, goal, me_map)
+                if way is not None:
+                    t = compose(pose, Pose2D(way[0], way[1], 0.0))
+                    return (t.x, t.y), "detour"
         point = None
         if blocked and len(self.trail):
             point = self.trail.pursuit_point(me_map.x, me_map.y, self.params["trail_lookahead"], behind_leader)
@@ -346,31 +363,35 @@ class FollowerController(object):
         t = relative(ref_map, Pose2D(point[0], point[1], 0.0))
         return (t.x, t.y), "trail"
 
-    def _scan_blocks(self, pose, slot):
-        """True when a laser point lies near the straight way from the robot towards its slot
-        (the first scan_horizon metres). Points within the leader's footprint are the leader."""
+    def _scan_points(self):
+        """The laser's points (robot frame) as far as the way checks look."""
         scan = self.scan
-        if scan is None:
-            return False
-        # the way to the slot in the follower's own frame
-        dx, dy = slot[0] - pose.x, slot[1] - pose.y
-        c, s = math.cos(-pose.theta), math.sin(-pose.theta)
-        gx, gy = c * dx - s * dy, s * dx + c * dy
-        length = math.hypot(gx, gy)
-        if length < 1e-6:
-            return False
-        ux, uy = gx / length, gy / length
-        horizon = min(length, self.params["scan_horizon"])
+        reach = self.params["scan_horizon"] + self.params["scan_clearance"]
+        return scan_points(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, reach)
+
+    def _detour(self, points, goal, me_map):
+        """A clear way round what stands between the robot and its slot (`goal`, robot frame),
+        also clear on the map; None next to a slot that something stands in (circling it would
+        not bring the robot in), or when no way is clear."""
+        distance = math.hypot(goal.x, goal.y)
         clearance = self.params["scan_clearance"]
-        for i, r in enumerate(scan.ranges):
-            if not (scan.range_min <= r <= horizon + clearance):
-                continue
-            a = scan.angle_min + i * scan.angle_increment
-            px, py = r * math.cos(a), r * math.sin(a)
-            along = px * ux + py * uy
-            if 0.0 <= along <= horizon and abs(-px * uy + py * ux) < clearance:
+        if distance < self.config.safety_distance and any(
+                math.hypot(px - goal.x, py - goal.y) < clearance for px, py in points):
+            return None
+
+        def is_free(x, y):
+            if self.free_space is None:
                 return True
-        return False
+            end = compose(me_map, Pose2D(x, y, 0.0))
+            return self.free_space.is_free(end.x, end.y) and self.free_space.segment_free(
+                me_map.x, me_map.y, end.x, end.y)
+
+        found = detour(points, goal.x, goal.y, self.params["scan_horizon"], clearance,
+                       self.params["detour_step"], self.params["detour_max_turn"], self._detour_side, is_free)
+        if found is None:
+            return None
+        way, self._detour_side = found
+        return way
 
     def _path_neighbours(self, a, now, frame):
         """The other followers' poses and path slots in `frame` (consensus along the path)."""
@@ -416,7 +437,7 @@ class FollowerController(object):
         msg = self._msg["FollowerState"]()
         msg.header.stamp = now
         msg.robot = self.robot
-        msg.active = mode in ("slot", "merge", "trail", "safety_stop", "give_way")
+        msg.active = mode in ("slot", "merge", "detour", "trail", "safety_stop", "give_way")
         msg.mode = mode
         if pose_stamp is not None:
             msg.pose_stamp = pose_stamp

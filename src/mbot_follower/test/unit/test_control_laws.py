@@ -1,4 +1,5 @@
-"""Control laws in closed loop without ROS, the command filter, safety stop, energy model."""
+"""Control laws in closed loop without ROS, the command filter, safety stop, the way round an
+obstacle, energy model."""
 import math
 import random
 import sys
@@ -7,9 +8,9 @@ import pytest
 
 from mbot_common.geometry import Pose2D, Twist2D
 from mbot_follower.control_laws import (CONTROL_LAWS, CommandFilter, Consensus, ControlInput,
-                                        ControllerConfig, SlotTracking, energy_rate, integrate,
-                                        main, make_control_law, safety_stop, simulate,
-                                        slot_velocity)
+                                        ControllerConfig, SlotTracking, detour, energy_rate, integrate,
+                                        main, make_control_law, safety_filter, safety_stop, scan_points,
+                                        simulate, slot_velocity, way_blocked)
 
 DT = 0.05
 SLOTS = [(-0.8, 0.8), (-0.8, -0.8), (-1.6, 0.0)]     # three followers behind the leader
@@ -284,6 +285,88 @@ def test_safety_stop_wraps_angles_of_a_scan_from_0_to_2pi():
     ranges = [float("inf")] * 360
     ranges[355] = 0.3                              # 355 deg = -5 deg: ahead
     assert safety_stop(ranges, 0.0, INC, 0.8, math.radians(30)) is True
+
+
+# ------------------------------------------------------------------ a way round an obstacle
+
+def disc_scan(pose, centre, radius, beams=BEAMS):
+    """A 360-beam scan (beam i at -180 + i deg of the robot's heading) of one disc in the world."""
+    ranges = []
+    for i in range(beams):
+        a = pose.theta + ANGLE_MIN + i * INC
+        dx, dy = math.cos(a), math.sin(a)
+        fx, fy = pose.x - centre[0], pose.y - centre[1]
+        b = fx * dx + fy * dy
+        disc = b * b - (fx * fx + fy * fy - radius * radius)
+        t = -b - math.sqrt(disc) if disc >= 0.0 else -1.0
+        ranges.append(t if t > 0.0 else float("inf"))
+    return ranges
+
+
+def test_scan_points_keep_readings_between_range_min_and_reach():
+    ranges = scan({0: 1.0, 90: 0.05, -90: 3.0, 180: float("nan"), 45: float("-inf")})
+    points = scan_points(ranges, ANGLE_MIN, INC, 0.1, 2.0)
+    assert points == [pytest.approx((1.0, 0.0))]
+
+
+@pytest.mark.parametrize("point,goal,blocked", [
+    ((1.0, 0.0), (2.0, 0.0), True),      # on the way
+    ((1.0, 0.34), (2.0, 0.0), True),     # within the clearance of it
+    ((1.0, 0.36), (2.0, 0.0), False),
+    ((-0.5, 0.0), (2.0, 0.0), False),    # behind the robot
+    ((2.5, 0.0), (2.0, 0.0), False),     # beyond the goal
+    ((2.5, 0.0), (4.0, 0.0), False),     # beyond the horizon (2 m)
+    ((0.0, 1.0), (0.0, 1.5), True),      # the way need not be straight ahead
+])
+def test_way_blocked(point, goal, blocked):
+    assert way_blocked([point], goal[0], goal[1], 2.0, 0.35) is blocked
+
+
+def test_detour_takes_the_smallest_clear_turn_and_keeps_to_its_side():
+    step, most = math.radians(15), math.radians(90)
+    # a robot 1 m ahead, a little to the left of the way: the smallest right turn is clear first
+    points = [(1.0, 0.1)]
+    (x, y), side = detour(points, 2.0, 0.0, 2.0, 0.35, step, most, prefer=1)
+    assert side == -1 and math.degrees(math.atan2(y, x)) == pytest.approx(-15.0)
+    assert math.hypot(x, y) == pytest.approx(2.0)          # as far away as the goal
+    # right in the way: both sides are equally good, the preferred one wins
+    assert detour([(1.0, 0.0)], 2.0, 0.0, 2.0, 0.35, step, most, prefer=-1)[1] == -1
+    assert detour([(1.0, 0.0)], 2.0, 0.0, 2.0, 0.35, step, most, prefer=1)[1] == 1
+    # a map that refuses the left side
+    (x, y), side = detour([(1.0, 0.0)], 2.0, 0.0, 2.0, 0.35, step, most, prefer=1, is_free=lambda x, y: y < 0.0)
+    assert side == -1
+    # walled in on both sides within 90 degrees: no way round
+    wall = [(0.5, 0.1 * k) for k in range(-10, 11)] + [(0.1 * k, 0.5) for k in range(6)] + \
+        [(0.1 * k, -0.5) for k in range(6)]
+    assert detour(wall, 2.0, 0.0, 2.0, 0.35, step, most) is None
+
+
+def test_a_robot_steers_round_a_standing_robot_to_the_slot_beyond_it():
+    """A diff-drive follower whose slot lies 3 m ahead, beyond a robot standing on the straight
+    way (the situation after a loss): with the way round it reaches the slot and passes the
+    standing robot with room to spare; its safety layer never has to stop it."""
+    config = ControllerConfig()
+    law, f = SlotTracking(), CommandFilter(config)
+    pose, slot, other = Pose2D(0.0, 0.0, 0.0), (3.0, 0.0), (1.5, 0.05)
+    side, nearest, held = 1, float("inf"), 0
+    for _ in range(int(20.0 / DT)):
+        ranges = disc_scan(pose, other, 0.15)
+        points = scan_points(ranges, ANGLE_MIN, INC, 0.1, 2.35)
+        goal = Pose2D(slot[0] - pose.x, slot[1] - pose.y, 0.0)
+        c, s = math.cos(-pose.theta), math.sin(-pose.theta)
+        gx, gy = c * goal.x - s * goal.y, s * goal.x + c * goal.y
+        target = slot
+        if way_blocked(points, gx, gy, 2.0, 0.35):
+            (wx, wy), side = detour(points, gx, gy, 2.0, 0.35, math.radians(15), math.radians(90), side)
+            c, s = math.cos(pose.theta), math.sin(pose.theta)
+            target = (pose.x + c * wx - s * wy, pose.y + s * wx + c * wy)
+        cmd = law.compute(ControlInput(pose, target, Twist2D(0.0, 0.0, 0.0), []), config)
+        cmd, stopped = safety_filter(f.apply(cmd, DT), ranges, ANGLE_MIN, INC, config)
+        held += stopped
+        pose = integrate(pose, cmd, DT)
+        nearest = min(nearest, math.hypot(pose.x - other[0], pose.y - other[1]))
+    assert math.hypot(pose.x - slot[0], pose.y - slot[1]) < 0.1
+    assert nearest > 0.45 and held == 0
 
 
 def test_energy_rate():
