@@ -55,7 +55,10 @@ until the slot has moved on. A lost robot that still stands there (its controlle
 the slots within ``lost_clearance`` of it in the same way: after a loss the re-planned slot of a
 follower may lie beside the dead robot, where the follower's safety layer stops it, gives way and
 tries again, and a leader waiting for it would wait for ever (until ``regroup_timeout``); once the
-leader drives on, the slot moves away from the dead robot. While such a slot is blocked the leader
+leader drives on, the slot moves away from the dead robot. Such a slot counts again as soon as it
+is ``lost_clearance`` from the dead robot: that distance already leaves the follower's safety
+layer room, and a follower that finds the robot on its way steers round it. While such a slot is
+blocked the leader
 waits for nobody: the follower held there also stands in the way of others (a 5-robot diamond
 that loses a front robot: its rear neighbour gets the dead robot's slot, and the other rear robot's
 new slot, the middle one, is 0.53 m beside that held neighbour), and only the leader driving on
@@ -267,10 +270,13 @@ class FleetCoordinator(object):
         if self.assignment is not None and self.assignment.leader in poses:
             leader = poses[self.assignment.leader]
             self._trail.add(leader.x, leader.y)
-        for r, why in self.blocked_followers(poses).items():
+        blocked_now = self.blocked_followers(poses)
+        for r, why in blocked_now.items():
             self._blocked_at[r] = now
             self._blocked_by[r] = why
-        self.blocked = sorted(r for r, t in self._blocked_at.items() if now - t < self.config.free_hold)
+        # a wall's slot counts again free_hold after it is clear; a lost robot's at once (module docstring)
+        self.blocked = sorted(r for r, t in self._blocked_at.items() if r in blocked_now or (
+            now - t < self.config.free_hold and not self._blocked_by[r].startswith(BESIDE_LOST)))
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
         if self._switch_started is not None and stable:

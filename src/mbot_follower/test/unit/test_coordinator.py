@@ -230,7 +230,9 @@ def test_a_slot_beside_a_lost_robot_standing_there_is_not_waited_for():
     """A diamond of 5 loses a rear follower whose robot stands still in its slot (its controller
     died). In the diamond of 4 the other rear follower's slot is the middle one, 0.53 m beside the
     dead robot, where its safety layer stops it: the leader does not wait for it until the slot
-    has been clear of the dead robot for free_hold (benchmark seed 4: 15 s of waiting before)."""
+    is lost_clearance from the dead robot (benchmark seed 4: 15 s of waiting before); then at
+    once (unlike a slot out of a wall, no free_hold: waiting the 3 s out, the leader drove a
+    follower held behind the dead robot 2.5 m away from its slot)."""
     core, t, poses = diamond_of_5_navigating()
     robots = list(poses)
     rear = sorted((r for r in robots if core.assignment.slots[r][0] < -2.0), key=lambda r: core.assignment.slots[r][1])
@@ -243,15 +245,16 @@ def test_a_slot_beside_a_lost_robot_standing_there_is_not_waited_for():
     assert core.lost == [dead] and core.assignment.slots[other] == pytest.approx((-2.12132, 0.0), abs=1e-4)
     assert core.slot_errors(poses)[other][0] == pytest.approx(0.53, abs=0.01)  # > regroup_error
     assert ("cancel", "leader") not in actions and core.blocked == [other], core.reason
-    # the leader drives on: 1 m on, the slot is 1.13 m from the dead robot, clear; still not
-    # waited for during free_hold ...
-    leader = Pose2D(1.0, 0.0, 0.0)
+    # the leader drives on: 0.4 m on, the slot is 0.67 m from the dead robot, still blocked ...
+    leader = Pose2D(0.4, 0.0, 0.0)
     poses = dict(at_slots(core, leader), **{dead: poses[dead], other: poses[other]})
     t += 0.1
     last.update({r: t for r in robots if r != dead})
     assert core.update(t, poses, last, leader_nav="ACTIVE") == [] and core.blocked == [other]
-    # ... then the follower 1.1 m off its slot is waited for
-    t += core.config.free_hold
+    # ... 1 m on, 1.13 m from it, clear: the follower 1.1 m off its slot is waited for at once
+    leader = Pose2D(1.0, 0.0, 0.0)
+    poses = dict(at_slots(core, leader), **{dead: poses[dead], other: poses[other]})
+    t += 0.1
     last.update({r: t for r in robots if r != dead})
     assert core.update(t, poses, last, leader_nav="ACTIVE") == [("cancel", "leader")]
     assert core.blocked == [] and "waits for %s" % other in core.reason
