@@ -15,7 +15,8 @@ Every control period (sim time) it
    only the laser sees (a robot, an obstacle) stands on the straight way to a rigid slot, a way
    round it (mode ``detour``: the way to the slot turned by the smallest multiple of
    ``~detour_step`` that is clear, control_laws.detour); or, when the slot or the way to it is
-   blocked otherwise (a wall, its inflation, no clear way round), a
+   blocked otherwise (a wall, its inflation, a wall the laser sees near the way, no clear way
+   round), a
    point on the leader's recent path (the trail) ``~trail_lookahead`` ahead of where the
    follower is on it, but no nearer the leader than the slot is: a path the leader drove is
    free, also around corners and through doors, and the follower rejoins its slot once the way
@@ -334,12 +335,13 @@ class FollowerController(object):
         """(target in the reference robot's frame, mode): the slot; or, when something only the
         laser sees stands on the straight way to a rigid slot (a robot, an obstacle), a way round
         it (mode detour); or, when the slot or the way to it is blocked otherwise (a wall of the
-        map, or no way round), the trail point. The trail is the leader's: in a chain the point
-        is `behind_leader` (the slot's distance from the leader) back on it, not the distance
-        from the robot ahead. A follower waiting beside a column's path (merging) does not check
-        its way with the laser: the robots it sees in its lane it waits for, and the trail would
-        take it onto the path out of turn. A column's follower (not rigid) keeps to the trail,
-        its slot's own path, rather than steer off it round the robot ahead."""
+        map, a wall the laser sees near the way, or no way round), the trail point. The trail is
+        the leader's: in a chain the point is `behind_leader` (the slot's distance from the
+        leader) back on it, not the distance from the robot ahead. A follower waiting beside a
+        column's path (merging) does not check its way with the laser: the robots it sees in its
+        lane it waits for, and the trail would take it onto the path out of turn. A column's
+        follower (not rigid) keeps to the trail, its slot's own path, rather than steer off it
+        round the robot ahead."""
         slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
         me_map = compose(ref_map, pose)
         blocked = False
@@ -349,8 +351,11 @@ class FollowerController(object):
         if not blocked and scan_check and self.scan is not None:
             goal = relative(pose, Pose2D(slot[0], slot[1], 0.0))   # the slot in the robot's own frame
             points = self._scan_points()
-            blocked = way_blocked(points, goal.x, goal.y, self.params["scan_horizon"], self.params["scan_clearance"])
-            if blocked and rigid:
+            horizon, clearance = self.params["scan_horizon"], self.params["scan_clearance"]
+            blocked = way_blocked(points, goal.x, goal.y, horizon, clearance)
+            # a wall (a door jamb) in the way: the leader's trail leads through, a turned way may not
+            if blocked and rigid and not way_blocked(self._wall_points(points, me_map), goal.x, goal.y,
+                                                     horizon, clearance):
                 way = self._detour(points, goal, me_map)
                 if way is not None:
                     t = compose(pose, Pose2D(way[0], way[1], 0.0))
@@ -368,6 +373,12 @@ class FollowerController(object):
         scan = self.scan
         reach = self.params["scan_horizon"] + self.params["scan_clearance"]
         return scan_points(scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, reach)
+
+    def _wall_points(self, points, me_map):
+        """The laser points (robot frame) that lie on a wall of /map or its margin."""
+        if self.free_space is None:
+            return []
+        return [p for p in points if not self.free_space.is_free(*transform_point(me_map, *p))]
 
     def _detour(self, points, goal, me_map):
         """A clear way round what stands between the robot and its slot (`goal`, robot frame),

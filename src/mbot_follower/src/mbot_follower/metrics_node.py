@@ -202,7 +202,7 @@ class MetricsNode(object):
         if self.writer is None:
             return
         with self.lock:
-            self.writer.write(self.collector.run, self.collector.summary())
+            self._write()
 
     def finish(self):
         """At shutdown: the last write, then no more messages."""
@@ -210,10 +210,20 @@ class MetricsNode(object):
             if self.closed:
                 return
             self.closed = True
-            if self.writer is not None:
-                self.writer.write(self.collector.run, self.collector.summary())
+            if self.writer is not None and self._write():
                 rospy.loginfo("%s: %d samples written to %s", rospy.get_name(), len(self.collector.run.samples),
                               self.writer.output_dir)
+
+    def _write(self):
+        """Write the record; a folder that is gone (a test removed it as the run ended) or full is
+        an error naming it, not a crash of the collector. Returns whether it was written."""
+        try:
+            self.writer.write(self.collector.run, self.collector.summary())
+            return True
+        except OSError as error:
+            rospy.logerr_throttle(10.0, "%s: cannot write the record to %s: %s" % (
+                rospy.get_name(), self.writer.output_dir, error))
+            return False
 
 
 def main():
