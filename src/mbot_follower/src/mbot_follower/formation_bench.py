@@ -233,7 +233,35 @@ def drive(n, seed, log):
     probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 300.0, "the last leg")
     result["contacts"] = len(probe.contacts)
     result["succeeded"] = probe.state() == "ARRIVED"
+    wait_for_record(rospy.get_time(), 120.0, log)
     return result
+
+
+def wait_for_record(until, wall_timeout, log):
+    """Wait (wall time) until the metrics collector's record reaches sim time `until`. On a busy
+    machine it lags behind the fleet (the simulator's lockstep waits for its heartbeat at most 2 s
+    of wall time), and stopping the fleet at once cut the record short: 10-robot seed 1 at load 80
+    lost the 33 s of sim time after its loss, and with them the recovery."""
+    import rospy
+    from std_msgs.msg import Header
+
+    newest = [None]
+
+    def on_heartbeat(msg):
+        if msg.frame_id.lstrip("/") == "metrics_collector":
+            newest[0] = msg.stamp.to_sec()
+
+    sub = rospy.Subscriber("/lockstep/heartbeat", Header, on_heartbeat, queue_size=50)
+    end = time.time() + wall_timeout
+    try:
+        while time.time() < end and not rospy.is_shutdown():
+            if newest[0] is not None and newest[0] >= until:
+                return True
+            time.sleep(0.1)
+    finally:
+        sub.unregister()
+    log("the metrics record reached sim time %s of %.2f s within %.0f s wall" % (newest[0], until, wall_timeout))
+    return False
 
 
 def run_one(n, seed, out_dir, log):
