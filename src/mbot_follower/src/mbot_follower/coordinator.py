@@ -159,7 +159,7 @@ class FleetCoordinator(object):
         self.assignment = None
         self.errors = None                   # ShapeErrors of the last update
         self.blocked = []                    # followers whose slots are (or just were) blocked
-        self._blocked_at = {}                # follower -> when its slot was last blocked
+        self._blocked_until = {}             # follower -> until when its slot counts as blocked
         self._blocked_by = {}                # follower -> what blocked it last ("in a wall", ...)
         self.events = []                     # (time, kind, text): switches, losses, rejoins, pauses
         self._stable_since = None
@@ -272,11 +272,10 @@ class FleetCoordinator(object):
             self._trail.add(leader.x, leader.y)
         blocked_now = self.blocked_followers(poses)
         for r, why in blocked_now.items():
-            self._blocked_at[r] = now
+            # a wall's slot counts again free_hold after it is clear; a lost robot's at once (module docstring)
+            self._blocked_until[r] = now if why.startswith(BESIDE_LOST) else now + self.config.free_hold
             self._blocked_by[r] = why
-        # a wall's slot counts again free_hold after it is clear; a lost robot's at once (module docstring)
-        self.blocked = sorted(r for r, t in self._blocked_at.items() if r in blocked_now or (
-            now - t < self.config.free_hold and not self._blocked_by[r].startswith(BESIDE_LOST)))
+        self.blocked = sorted(r for r, until in self._blocked_until.items() if r in blocked_now or now < until)
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
         if self._switch_started is not None and stable:
@@ -486,7 +485,7 @@ class FleetCoordinator(object):
             self.assignment = None
             return []
         leader_pose = poses[self.leader]
-        self._blocked_at, self._blocked_by = {}, {}
+        self._blocked_until, self._blocked_by = {}, {}
         # the leader's path starts here: path slots are the rigid slots at first
         self._trail.start(leader_pose.x, leader_pose.y, leader_pose.theta)
         if len(self.members) == 1:  # the leader alone: no shape to keep

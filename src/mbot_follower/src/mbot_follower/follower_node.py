@@ -344,10 +344,7 @@ class FollowerController(object):
         round the robot ahead."""
         slot_map = compose(ref_map, Pose2D(slot[0], slot[1], 0.0))
         me_map = compose(ref_map, pose)
-        blocked = False
-        if self.free_space is not None:
-            blocked = not self.free_space.is_free(slot_map.x, slot_map.y) or not self.free_space.segment_free(
-                me_map.x, me_map.y, slot_map.x, slot_map.y)
+        blocked = not self._map_way_free(me_map, slot_map)
         if not blocked and scan_check and self.scan is not None:
             goal = relative(pose, Pose2D(slot[0], slot[1], 0.0))   # the slot in the robot's own frame
             points = self._scan_points()
@@ -367,6 +364,13 @@ class FollowerController(object):
             return slot, "slot"
         t = relative(ref_map, Pose2D(point[0], point[1], 0.0))
         return (t.x, t.y), "trail"
+
+    def _map_way_free(self, me_map, end):
+        """The map point `end` and the straight way to it from `me_map` are clear of the walls of
+        /map and their margin (True without a map)."""
+        if self.free_space is None:
+            return True
+        return self.free_space.is_free(end.x, end.y) and self.free_space.segment_free(me_map.x, me_map.y, end.x, end.y)
 
     def _scan_points(self):
         """The laser's points (robot frame) as far as the way checks look."""
@@ -391,11 +395,7 @@ class FollowerController(object):
             return None
 
         def is_free(x, y):
-            if self.free_space is None:
-                return True
-            end = compose(me_map, Pose2D(x, y, 0.0))
-            return self.free_space.is_free(end.x, end.y) and self.free_space.segment_free(
-                me_map.x, me_map.y, end.x, end.y)
+            return self._map_way_free(me_map, compose(me_map, Pose2D(x, y, 0.0)))
 
         found = detour(points, goal.x, goal.y, self.params["scan_horizon"], clearance,
                        self.params["detour_step"], self.params["detour_max_turn"], self._detour_side, is_free)
