@@ -24,9 +24,9 @@ Every control period (sim time) it
    off) has no such point: the follower keeps to its slot (its safety layer stops it short of
    what blocks it) rather than drive ahead of the robots that belong in front of it. A column's
    follower joins the leader's path in slot order (merge.py): while the robot of the slot ahead
-   of its own is not ``~merge_gap`` ahead of it along the path, it waits in a lane
-   ``~merge_lane`` beside the path (mode ``merge``), so two followers coming from a diamond's two
-   sides do not meet on the path and hold each other;
+   of its own is not ahead of it, it waits in a lane ``~merge_lane`` beside the path (mode
+   ``merge``), then slides in behind it at ``~merge_gap`` from it, so two followers coming from a
+   diamond's two sides do not meet on the path and hold each other;
 4. runs the control law (``control_laws.py``: slot tracking or consensus), smooths and limits
    the command, and gives the safety layer the last word (``safety_filter``): anything closer
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
@@ -66,7 +66,7 @@ NODE_PARAMS = {
     "trail_lookahead": 0.6,   # on the trail, drive to the point this far ahead on it [m]
     "path_turn_window": 0.2,  # a path slot turns as the path does over this much path ahead of it [m]
     "merge_lane": 0.7,        # a column follower waits this far beside the path for its turn [m]
-    "merge_gap": 0.6,         # ... until the robot of the slot ahead is this far ahead along it [m]
+    "merge_gap": 0.6,         # ... then slides in behind the robot of the slot ahead, this far from it [m]
 }
 HOLD_STATES = ("IDLE", "ABORTED")
 
