@@ -25,7 +25,7 @@ import rospy
 from mbot_common.geometry import Pose2D
 from mbot_follower.control_laws import safety_stop
 from mbot_follower.coordinator import ABORTED, ARRIVED, CoordinatorConfig, FleetCoordinator
-from mbot_follower.fleet_io import StalePose, assignment_to_msg, lookup_pose
+from mbot_follower.fleet_io import StalePose, assignment_to_msg, lookup_pose, quiet_at_shutdown
 from mbot_follower.formations import FormationLibrary
 from mbot_follower.free_space import FreeSpace
 from mbot_follower import markers
@@ -128,7 +128,7 @@ class CoordinatorNode(object):
         self._connect_nav_thread = threading.Thread(target=self._connect_nav, daemon=True)
         self._connect_nav_thread.start()
         self._leader_speed = NavSpeedLimit()
-        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), self._cycle)
+        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
         rospy.loginfo("coordinator: robots %s, leader %s, formation %s (spacing %.2f m)", ", ".join(self.robots),
                       leader, self.core.formation, self.core.spacing)
 

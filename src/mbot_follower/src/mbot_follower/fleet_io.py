@@ -6,6 +6,7 @@ every driven robot has sent its command. A lookup that waited in sim time (tf2's
 hold the clock it waits for. So a lookup takes the newest transform and refuses it when it is
 older than a bound, after polling for a newer one for a moment of wall time.
 """
+import functools
 from collections import namedtuple
 
 from mbot_common.geometry import Pose2D, yaw_of
@@ -19,6 +20,23 @@ Assignment = namedtuple("Assignment", "leader formation spacing slots follows al
 
 class StalePose(Exception):
     """A tf lookup that failed or whose newest transform is too old; the message says which."""
+
+
+def quiet_at_shutdown(callback):
+    """A timer callback that ends quietly when the node shuts down under it: rospy closes the
+    publishers before it stops the timers, and a cycle running then would print a traceback
+    ("publish() to a closed topic")."""
+    import rospy
+
+    @functools.wraps(callback)
+    def wrapped(*args):
+        try:
+            return callback(*args)
+        except rospy.ROSException:
+            if rospy.is_shutdown():
+                return None
+            raise
+    return wrapped
 
 
 def assignment_from_msg(msg):

@@ -46,7 +46,7 @@ import rospy
 from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, detour,
                                         energy_rate, make_control_law, safety_filter, scan_points, way_blocked)
-from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose
+from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.merge import merge_target, robot_ahead
 from mbot_follower.trail import Trail, path_pose, path_slot
@@ -124,7 +124,7 @@ class FollowerController(object):
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
         rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1)
         rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
-        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), self._cycle)
+        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
         rospy.loginfo("%s: follower controller (%s) ready", rospy.get_name(), self.params["controller"])
 
     # --- parameters ---------------------------------------------------------------------------

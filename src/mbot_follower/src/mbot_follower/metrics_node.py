@@ -29,7 +29,7 @@ from std_msgs.msg import Float64, Header
 
 from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
-from mbot_follower.fleet_io import assignment_from_msg
+from mbot_follower.fleet_io import assignment_from_msg, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter
 
@@ -235,7 +235,7 @@ def main():
         rospy.logfatal(str(error))
         return 1
     rospy.on_shutdown(node.finish)
-    rospy.Timer(rospy.Duration(params["publish_period"]), node.publish)
+    rospy.Timer(rospy.Duration(params["publish_period"]), quiet_at_shutdown(node.publish))
     rospy.Timer(rospy.Duration(params["write_period"]), node.save)
     rospy.spin()
     return 0
