@@ -402,6 +402,9 @@ void StageRos::noteBoundary()
 /// After ~lockstep_wall_timeout the robots whose controller did not answer count as not driven
 /// until their next cmd_vel, and a localization still behind is not waited for until it has caught
 /// up by itself, so a dead controller or localization costs one timeout, not one per boundary.
+/// A pacer is waited for as long as its heartbeat moves on within ~lockstep_wall_timeout: it is
+/// alive, only slow (a metrics collector on a loaded machine), and ignoring it would leave it
+/// behind for good, since sim time then runs away from it. A silent one is ignored likewise.
 /// @return false when paused or shut down while waiting (the wait is still pending)
 bool StageRos::waitForControllers()
 {
@@ -428,7 +431,11 @@ bool StageRos::waitForControllers()
     for (const auto& p : pacers_)
       if (!paced(p.second)) all_answered = false;
     if (all_answered) break;
-    if (ros::WallTime::now() >= deadline)
+    const ros::WallTime wall_now = ros::WallTime::now();
+    bool pacer_moving = false;
+    for (const auto& p : pacers_)
+      if (!paced(p.second) && (wall_now - p.second.moved).toSec() < params_.lockstep_wall_timeout) pacer_moving = true;
+    if (wall_now >= deadline && !pacer_moving)
     {
       std::string late;
       for (auto& io : io_)
@@ -454,7 +461,6 @@ bool StageRos::waitForControllers()
           p.second.ignored = true;
         }
       ++lockstep_timeouts_;
-      const ros::WallTime wall_now = ros::WallTime::now();
       if ((wall_now - last_lockstep_warning_).toSec() >= 5.0)  // throttled: a slow controller times out often
       {
         ROS_WARN(
@@ -618,7 +624,11 @@ void StageRos::onHeartbeat(const std_msgs::Header::ConstPtr& msg)
 {
   if (msg->frame_id.empty()) return;
   Pacer& p = pacers_[msg->frame_id];
-  p.stamp = std::max(p.stamp, msg->stamp.toSec());
+  if (msg->stamp.toSec() > p.stamp)
+  {
+    p.stamp = msg->stamp.toSec();
+    p.moved = ros::WallTime::now();
+  }
   if (p.ignored && p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9) p.ignored = false;  // caught up
 }
 

@@ -14,6 +14,12 @@ A slow localization for robot_1 (not driven) holds sim time the same way: it ans
 20 ms late with map -> robot_1/odom stamped at that boundary, and sim time never gets more than
 ~lockstep_localization_lag + one period (+ one step) past the newest stamp. When it stops, sim time
 runs on after one wall timeout.
+
+A slow pacer (a node that sends its progress on /lockstep/heartbeat) holds sim time even when one
+boundary takes it longer than the wall timeout: its heartbeat moves on, 2 ms of sim time every
+0.25 s wall, so it is alive, and sim time never gets more than ~lockstep_pacer_lag + one period
+(+ one step) past its newest stamp. (Ignoring it after one timeout left it behind for good: sim
+time ran away from it.) When it falls silent, sim time runs on after one wall timeout.
 """
 import math
 import sys
@@ -27,6 +33,7 @@ import yaml
 from geometry_msgs.msg import Twist
 from geometry_msgs.msg import TransformStamped
 from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Header
 from tf2_msgs.msg import TFMessage
 
 ANSWER_DELAY = 0.02  # [s wall] how long the controller "computes"
@@ -157,6 +164,44 @@ class SimLockstep(unittest.TestCase):
         self.assertGreater(sim_driven, (ANSWERS - 5) * period)
         self.assertLess(sim_driven, (ANSWERS + 3) * period)
         wait_for_release(watch, "the commands")
+
+    def test_slow_pacer_holds_sim_time_past_the_wall_timeout_and_release(self):
+        period, step = sim_settings()
+        lag = rospy.get_param("/stage_node/lockstep_pacer_lag")
+        timeout = rospy.get_param("/stage_node/lockstep_wall_timeout")
+        limit = lag + period + step + 1e-6
+        watch = ClockWatch(limit)
+        pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10, tcp_nodelay=True)
+        wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
+        increment, interval = 0.002, 0.25   # a boundary (0.05 s sim) takes it 6.25 s wall
+        self.assertGreater(period / increment * interval, timeout)
+        # Sim time runs free (an earlier test's node stopped): keep up with it until it holds
+        # for the pacer, which cannot start behind it (sim time cannot go back).
+        deadline = time.time() + 20.0
+        while True:
+            stamp = watch.now()
+            pub.publish(Header(stamp=rospy.Time.from_sec(stamp), frame_id="/slow_pacer"))
+            time.sleep(0.2)
+            if watch.now() <= stamp + limit:
+                break
+            self.assertLess(time.time(), deadline, "sim time did not hold for the pacer")
+        with watch.lock:
+            watch.last_answered = stamp
+        wall_end = time.time() + 3.0 * timeout
+        while time.time() < wall_end:
+            time.sleep(interval)
+            stamp += increment
+            with watch.lock:  # before sending: the sim cannot move on before it gets the heartbeat
+                watch.last_answered = stamp
+            pub.publish(Header(stamp=rospy.Time.from_sec(stamp), frame_id="/slow_pacer"))
+        with watch.lock:
+            watch.last_answered = None
+            violations, worst = list(watch.violations), watch.worst_lead
+        print("slow pacer: heartbeat at %.3f s sim after %.0f s wall; largest lead over it %.3f s (allowed %.3f s)"
+              % (stamp, 3.0 * timeout, worst, limit))
+        self.assertEqual(len(violations), 0, "sim time ran ahead of the slow pacer (heartbeat, sim time): %s"
+                         % violations[:5])
+        wait_for_release(watch, "the pacer")
 
 
 if __name__ == "__main__":

@@ -171,6 +171,7 @@ private:
   {
     double stamp = -1e9;
     bool ignored = false;
+    ros::WallTime moved;  ///< wall time the stamp last moved on
   };
   std::map<std::string, Pacer> pacers_;  ///< by node name (the heartbeat's frame_id)
   long lockstep_timeouts_ = 0;           ///< wall timeouts since the last warning
