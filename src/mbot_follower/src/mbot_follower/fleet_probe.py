@@ -24,6 +24,7 @@ from mbot_follower.trail import Trail, slot_pose
 WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
 HISTORY = 50        # ground truth messages kept per robot (1 s at 50 Hz) to align the samples
 SILENT_AFTER = 0.5  # [s sim] a robot whose ground truth is this far behind the newest is gone
+RESUBSCRIBE_AFTER = 20.0  # [s wall] wait_for_fleet subscribes again to a topic still silent after this
 
 
 def aligned(histories):
@@ -74,8 +75,7 @@ class FleetProbe(object):
         self.trail = Trail()   # the leader's ground truth since the assignment (path slots)
         self._trail_pending = False
         self.contacts = []
-        for r in robots:
-            rospy.Subscriber("/%s/base_pose_ground_truth" % r, Odometry, self._on_truth, callback_args=r, queue_size=5)
+        self._truth_subs = {r: self._subscribe_truth(r) for r in robots}
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=50)
         rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=5)
         rospy.Subscriber("/contacts", Contact, self._on_contact, queue_size=100)
@@ -87,6 +87,10 @@ class FleetProbe(object):
                                                 self._on_follower, queue_size=5) for r in robots}
         self._heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10) if pace else None
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
+
+    def _subscribe_truth(self, robot):
+        return rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_truth, callback_args=robot,
+                                queue_size=5)
 
     def _on_follower(self, msg):
         self.modes[msg.robot] = msg.mode
@@ -209,17 +213,33 @@ class FleetProbe(object):
         from mbot_navigation.move_base_client import connect_move_base
 
         heard = set()
-        subs = [rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
-                                 lambda msg, r=r: heard.add(r), queue_size=1) for r in self.robots]
+
+        def listen(r):
+            return rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
+                                    lambda msg: heard.add(r), queue_size=1)
+
+        subs = {r: listen(r) for r in self.robots}
         end = time.time() + wall_timeout
+        again = time.time() + RESUBSCRIBE_AFTER
         while time.time() < end and not rospy.is_shutdown():
             with self.lock:
                 everyone = len(self.truth) == len(self.robots) and len(heard) == len(self.robots)
                 ready = self.status is not None and everyone
             if ready:
                 break
+            if time.time() > again:
+                # At load 50 one of five ground-truth subscriptions once never connected (rospy
+                # got the publisher twice at once): subscribe again to what is still silent.
+                for r in self.robots:
+                    if r not in self.truth:
+                        self._truth_subs[r].unregister()
+                        self._truth_subs[r] = self._subscribe_truth(r)
+                    if r not in heard:
+                        subs[r].unregister()
+                        subs[r] = listen(r)
+                again = time.time() + RESUBSCRIBE_AFTER
             time.sleep(0.1)
-        for sub in subs:
+        for sub in subs.values():
             sub.unregister()
         if not ready:
             raise AssertionError("fleet not up after %.0f s wall: status %s, ground truth of %s, controllers of %s" % (

@@ -1,6 +1,9 @@
 """FleetProbe's samples pair the robots' ground truth of one instant (aligned), not each
-robot's newest message: a loaded test process runs the callbacks late and in any order."""
+robot's newest message: a loaded test process runs the callbacks late and in any order. Its
+wait for the fleet subscribes again to a topic that stays silent."""
 import collections
+
+import rospy
 
 from mbot_common.geometry import Pose2D
 from mbot_follower.fleet_probe import SILENT_AFTER, aligned
@@ -34,3 +37,47 @@ def test_a_silent_robot_keeps_its_last_pose_and_does_not_hold_the_others_back():
     assert sample["a"][0] == sample["b"][0] == live[-1]
     assert sample["removed"][0] == 0.02 and live[-1] - 0.02 > SILENT_AFTER
     assert aligned({}) == {} and aligned({"a": collections.deque()}) == {}
+
+
+class FakeRospy(object):
+    """Subscribers that deliver one message as they are made, except the first subscription to
+    each topic in `stuck` (a subscription whose connection never formed)."""
+
+    def __init__(self, stuck):
+        self.stuck = set(stuck)
+        self.made = collections.Counter()
+
+    def subscriber(self, topic, kind, callback, callback_args=None, queue_size=None):
+        from unittest import mock
+        self.made[topic] += 1
+        if topic in self.stuck and self.made[topic] == 1:
+            return mock.Mock()
+        msg = kind()
+        msg.header.stamp = rospy.Time(1.0)
+        if hasattr(msg, "pose"):
+            msg.pose.pose.orientation.w = 1.0
+        if callback_args is None:
+            callback(msg)
+        else:
+            callback(msg, callback_args)
+        return mock.Mock()
+
+
+def test_wait_for_fleet_subscribes_again_to_a_ground_truth_that_stays_silent(monkeypatch):
+    from unittest import mock
+
+    import mbot_follower.fleet_probe as fp
+    import mbot_navigation.move_base_client as mbc
+
+    fake = FakeRospy(stuck=["/b/base_pose_ground_truth"])
+    monkeypatch.setattr(rospy, "Subscriber", fake.subscriber)
+    monkeypatch.setattr(rospy, "Publisher", mock.Mock())
+    monkeypatch.setattr(rospy, "Timer", mock.Mock())
+    monkeypatch.setattr(rospy, "is_shutdown", lambda: False)
+    monkeypatch.setattr(mbc, "connect_move_base", lambda robot, timeout: None)
+    monkeypatch.setattr(fp, "RESUBSCRIBE_AFTER", 0.2)
+    probe = fp.FleetProbe(["a", "b"])
+    assert sorted(probe.truth) == ["a"]
+    probe.wait_for_fleet(wall_timeout=5.0)
+    assert sorted(probe.truth) == ["a", "b"]
+    assert fake.made["/b/base_pose_ground_truth"] == 2 and fake.made["/a/base_pose_ground_truth"] == 1
