@@ -42,7 +42,8 @@ s = (s_x, s_y) of L; the leader moves with the twist (v_L, w_L) in its own body 
    (while it faces away, the projection of u on its heading is negative and it can only back up,
    at most max_reverse_vel, which also moves it towards the slot). Close to a still slot
    (|u| small) it does not turn around: it faces the leader's way and backs up the last
-   centimetres. Backing up fast is never done: a diff-drive robot cannot see behind it.
+   centimetres. Backing up stays slow: turning round and driving forward at up to
+   max_linear_vel is quicker for all but a short way.
 
 4. CommandFilter smooths the command, limits the acceleration, then the velocity. safety_stop
    says when the laser sees something too close ahead. way_blocked says when something stands
