@@ -83,14 +83,16 @@ class FleetProbe(object):
         self.formation_pub = rospy.Publisher("/fleet/formation", String, queue_size=1, latch=True)
         self.modes = {}        # robot -> its follower controller's last mode
         self.heartbeats = {}   # robot -> stamp of its controller's last state [s sim]
-        self._state_subs = {r: rospy.Subscriber("/%s/follower_controller/state" % r, FollowerState,
-                                                self._on_follower, queue_size=5) for r in robots}
+        self._state_subs = {r: self._subscribe_state(r) for r in robots}
         self._heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10) if pace else None
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
 
     def _subscribe_truth(self, robot):
         return rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_truth, callback_args=robot,
                                 queue_size=5)
+
+    def _subscribe_state(self, robot):
+        return rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self._on_follower, queue_size=5)
 
     def _on_follower(self, msg):
         self.modes[msg.robot] = msg.mode
@@ -234,8 +236,10 @@ class FleetProbe(object):
                     if r not in self.truth:
                         self._truth_subs[r].unregister()
                         self._truth_subs[r] = self._subscribe_truth(r)
-                    if r not in heard:
+                    if r not in heard:  # (one connection per topic and process: renew both)
                         subs[r].unregister()
+                        self._state_subs[r].unregister()
+                        self._state_subs[r] = self._subscribe_state(r)
                         subs[r] = listen(r)
                 again = time.time() + RESUBSCRIBE_AFTER
             time.sleep(0.1)

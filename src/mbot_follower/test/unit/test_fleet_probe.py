@@ -40,17 +40,17 @@ def test_a_silent_robot_keeps_its_last_pose_and_does_not_hold_the_others_back():
 
 
 class FakeRospy(object):
-    """Subscribers that deliver one message as they are made, except the first subscription to
-    each topic in `stuck` (a subscription whose connection never formed)."""
+    """Subscribers that deliver one message as they are made, except the first `stuck[topic]`
+    subscriptions to a topic (a connection that never formed)."""
 
     def __init__(self, stuck):
-        self.stuck = set(stuck)
+        self.stuck = stuck
         self.made = collections.Counter()
 
     def subscriber(self, topic, kind, callback, callback_args=None, queue_size=None):
         from unittest import mock
         self.made[topic] += 1
-        if topic in self.stuck and self.made[topic] == 1:
+        if self.made[topic] <= self.stuck.get(topic, 0):
             return mock.Mock()
         msg = kind()
         msg.header.stamp = rospy.Time(1.0)
@@ -63,13 +63,14 @@ class FakeRospy(object):
         return mock.Mock()
 
 
-def test_wait_for_fleet_subscribes_again_to_a_ground_truth_that_stays_silent(monkeypatch):
+def test_wait_for_fleet_subscribes_again_to_what_stays_silent(monkeypatch):
     from unittest import mock
 
     import mbot_follower.fleet_probe as fp
     import mbot_navigation.move_base_client as mbc
 
-    fake = FakeRospy(stuck=["/b/base_pose_ground_truth"])
+    # b's ground truth, and b's controller state for the probe's and the wait's own subscriber
+    fake = FakeRospy(stuck={"/b/base_pose_ground_truth": 1, "/b/follower_controller/state": 2})
     monkeypatch.setattr(rospy, "Subscriber", fake.subscriber)
     monkeypatch.setattr(rospy, "Publisher", mock.Mock())
     monkeypatch.setattr(rospy, "Timer", mock.Mock())
@@ -81,3 +82,4 @@ def test_wait_for_fleet_subscribes_again_to_a_ground_truth_that_stays_silent(mon
     probe.wait_for_fleet(wall_timeout=5.0)
     assert sorted(probe.truth) == ["a", "b"]
     assert fake.made["/b/base_pose_ground_truth"] == 2 and fake.made["/a/base_pose_ground_truth"] == 1
+    assert fake.made["/b/follower_controller/state"] == 4 and fake.made["/a/follower_controller/state"] == 2
