@@ -284,7 +284,13 @@ class CoordinatorNode(object):
             if nav != self._last_nav:
                 rospy.loginfo("coordinator: %s's navigation: %s", leader, nav or "no goal")
                 self._last_nav = nav
+            lost_before = set(self.core.lost)
             actions = self.core.update(now, poses, last_heard, nav, obstacle, excused)
+            for robot in sorted(set(self.core.lost) - lost_before):
+                rospy.logwarn("coordinator: %s unheard: newest pose %.2f s old, controller state %.2f s old "
+                              "(all poses %.2f s behind, all controller states %.2f s behind)", robot,
+                              now - self.last_heard_pose.get(robot, -1e9),
+                              now - self.last_heard_controller.get(robot, -1e9), pose_lag, controller_lag)
             # the assignment and the status of one decision carry its time: a metrics sample
             # between two stamps would see the new slots under the old state
             self._run(actions, now_ros)

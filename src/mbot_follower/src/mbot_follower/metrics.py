@@ -504,7 +504,7 @@ def recoveries(run):
     return out
 
 
-def _leader_speed(before, now):
+def leader_speed(before, now):
     """Speed [m/s] of now's leader between two samples; 0 if unknown (no pose, new leader)."""
     leader = now.leader
     if not leader or leader != before.leader or now.t <= before.t \
@@ -560,7 +560,7 @@ def summarize(run):
                      if math.isfinite(rs.slot_error) and not _controller_silent(heard.get(r, ()), s.t, config)}
         if s.state == "ARRIVED":
             arrived += [rs.slot_error for rs in followers.values()]
-        elif s.state == "NAVIGATING" and i > 0 and _leader_speed(run.samples[i - 1], s) > config.moving_speed:
+        elif s.state == "NAVIGATING" and i > 0 and leader_speed(run.samples[i - 1], s) > config.moving_speed:
             for r, rs in followers.items():
                 moving_samples += 1
                 if s.t - blocked_since.get(r, -math.inf) >= config.free_hold - 1e-9:

@@ -2,8 +2,8 @@
 data's sim time), not from when its probe noticed a condition."""
 import math
 
-from mbot_follower.formation_bench import start_poses, timings, worst
-from mbot_follower.metrics import ControllerSample, Event, Run, Sample
+from mbot_follower.formation_bench import moving_rms, start_poses, timings, worst
+from mbot_follower.metrics import ControllerSample, Event, RobotSample, Run, Sample
 
 NAN = float("nan")
 
@@ -45,7 +45,8 @@ def recorded_run():
 
 def test_the_times_come_from_the_stamps_of_the_record():
     got = timings(recorded_run())
-    assert got == {"converge_s": 4.5, "switch_s": 4.3, "degraded_s": 1.1, "recover_s": 4.0}
+    assert got == {"converge_s": 4.5, "switch_s": 4.3, "degraded_s": 1.1, "recover_s": 4.0,
+                   "rms_straight_m": None, "rms_route_m": None}   # no robot in these samples
 
 
 def test_the_switch_ends_only_in_the_new_formation_and_under_the_tolerance():
@@ -106,3 +107,35 @@ def test_the_start_poses_are_seeded_and_apart():
             for _, b in poses[i + 1:]:
                 assert math.hypot(a.x - b.x, a.y - b.y) >= 0.6
         assert start_poses(n, seed=4) == poses   # seeded
+
+
+def moving_sample(t, state, leader_x, errors):
+    robots = {"robot_0": RobotSample(leader_x, 0.0, 0.0, NAN, NAN, 0.0, 0.0)}
+    robots.update({r: RobotSample(leader_x - 1.5, 0.0, 0.0, e, e, 0.0, 0.0) for r, e in errors.items()})
+    return Sample(t, state, "robot_0", "triangle", (), NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, "", robots)
+
+
+def test_the_slot_rms_comes_from_the_record_while_the_leader_moves():
+    """Straight run: NAVIGATING at 14.5 s, measured from 17.5 s until the switch at 50 s; only
+    samples in which the fleet navigates and the leader moves >= 0.1 m/s count."""
+    run = recorded_run()
+    x = 0.0
+    run.samples = []
+    for k in range(0, 400):   # 10 Hz from 10 s to 50 s
+        t = round(10.0 + 0.1 * k, 1)
+        state = "FORMING" if t < 14.5 else "NAVIGATING"
+        stopped = 30.0 <= t < 31.0               # the leader stands: errors ignored
+        x += 0.0 if (stopped or state == "FORMING") else 0.05
+        if t < 17.5 or stopped:
+            errors = {"robot_1": 1.0, "robot_2": 1.0}
+        else:
+            errors = {"robot_1": 0.03, "robot_2": 0.04}
+        run.samples.append(moving_sample(t, state, x, errors))
+    run.samples.append(moving_sample(50.0, "NAVIGATING", x + 0.05, {"robot_1": 2.0, "robot_2": 2.0}))  # the switch
+    got = timings(run, route=(20.0, 25.0))
+    assert math.isclose(got["rms_straight_m"], 0.0354, abs_tol=1e-4)   # sqrt((0.03^2 + 0.04^2) / 2)
+    assert math.isclose(got["rms_route_m"], 0.0354, abs_tol=1e-4)
+    # a false loss's re-planned slots in the window count: the record shows what the fleet did
+    run.samples[300] = moving_sample(40.0, "DEGRADED", run.samples[300].robots["robot_0"].x, {"robot_1": 1.8})
+    assert timings(run)["rms_straight_m"] > 0.05
+    assert moving_rms(run, 30.0, 31.0) is None   # the leader stood still
