@@ -39,6 +39,8 @@ NODE_PARAMS = {
     "debug_mode": False,       # print every follower's slot error once per second
     "startup_timeout": 60.0,   # [s wall] wait this long for every robot before counting absent ones lost
     "view_frame": "fleet",     # tf frame at the middle of the fleet ("" = none)
+    "lockstep": False,         # the simulator's lockstep holds sim time for this node's heartbeat
+    "loss_wall_wait": 1.0,     # [s wall] under lockstep: how long an overdue robot is waited for
 }
 
 
@@ -96,6 +98,7 @@ class CoordinatorNode(object):
         self._last_status = None
         self._last_debug = None
         self._startup_done = False
+        self._waited_for = set()     # overdue robots given their wall-time wait (lockstep)
         self._last_nav = None
         self._wall_start = time.time()
 
@@ -247,9 +250,8 @@ class CoordinatorNode(object):
         self._heartbeat.stamp = started
         self.heartbeat_pub.publish(self._heartbeat)
 
-    def _step(self, _event):
-        now_ros = rospy.Time.now()
-        now = now_ros.to_sec()
+    def _look_up_poses(self, now_ros):
+        """{robot: Pose2D} of the robots with a current pose; notes when each was last heard of."""
         poses = {}
         for robot in self.robots:
             try:
@@ -258,20 +260,63 @@ class CoordinatorNode(object):
             except StalePose:
                 continue
             self.last_heard_pose[robot] = stamp.to_sec()
-            if now - stamp.to_sec() <= self.params["max_pose_age"]:
+            if now_ros.to_sec() - stamp.to_sec() <= self.params["max_pose_age"]:
                 poses[robot] = pose
+        return poses
+
+    def _last_heard(self, now, leader):
+        """({robot: sim time it was last complete}, lag of all poses, lag of all controller states)."""
+        pose_lag = _lag(self.last_heard_pose, now)
+        # the leader's own controller is idle and always quick: judge followers by followers
+        controller_lag = _lag({r: t for r, t in self.last_heard_controller.items() if r != leader}, now)
+        last_heard = {}
+        for robot in self.robots:
+            heard = self.last_heard_pose.get(robot, -1e9) + pose_lag
+            if robot != leader:  # a follower also needs its controller
+                heard = min(heard, self.last_heard_controller.get(robot, -1e9) + controller_lag)
+            last_heard[robot] = heard
+        return last_heard, pose_lag, controller_lag
+
+    def _overdue(self, now, leader):
+        """The members unheard for longer than the loss timeout."""
+        last_heard = self._last_heard(now, leader)[0]
+        with self.lock:
+            return {r for r in self.core.members if now - last_heard[r] > self.core.config.loss_timeout}
+
+    def _wait_for_overdue(self, now_ros, leader, poses):
+        """Under lockstep, give members whose messages are overdue ~loss_wall_wait of wall time
+        before they count as lost; returns the poses looked up again. On a loaded machine one
+        connection's messages can stall for a second of sim time while the robot's controller
+        runs every cycle (a 3-robot benchmark run lost a follower for 0.15 s so). Meanwhile this
+        node's heartbeat stands, and with it sim time (but for the simulator's pacer lag), so the
+        wait costs little sim time. A robot that stays silent is waited for once."""
+        if not (self._startup_done and self.params["lockstep"]):
+            return poses
+        now = now_ros.to_sec()
+        overdue = self._overdue(now, leader)
+        self._waited_for &= overdue   # heard again: its next silence is waited for again
+        if not overdue - self._waited_for:
+            return poses
+        started = time.time()
+        while time.time() - started < self.params["loss_wall_wait"] and not rospy.is_shutdown():
+            time.sleep(0.01)
+            poses = self._look_up_poses(now_ros)
+            if not overdue & self._overdue(now, leader):
+                rospy.logwarn("coordinator: the messages of %s came %.2f s of wall time late (a loaded machine)",
+                              ", ".join(sorted(overdue)), time.time() - started)
+                return poses
+        self._waited_for |= self._overdue(now, leader)
+        return poses
+
+    def _step(self, _event):
+        now_ros = rospy.Time.now()
+        now = now_ros.to_sec()
+        leader = self.core.leader
+        poses = self._wait_for_overdue(now_ros, leader, self._look_up_poses(now_ros))
         with self.lock:
             self.poses = poses
             leader = self.core.leader
-            last_heard = {}
-            pose_lag = _lag(self.last_heard_pose, now)
-            # the leader's own controller is idle and always quick: judge followers by followers
-            controller_lag = _lag({r: t for r, t in self.last_heard_controller.items() if r != leader}, now)
-            for robot in self.robots:
-                heard = self.last_heard_pose.get(robot, -1e9) + pose_lag
-                if robot != leader:  # a follower also needs its controller
-                    heard = min(heard, self.last_heard_controller.get(robot, -1e9) + controller_lag)
-                last_heard[robot] = heard
+            last_heard, pose_lag, controller_lag = self._last_heard(now, leader)
             if not self._started(last_heard, now):
                 return
             self._follow_leader_scan(leader)
