@@ -451,7 +451,8 @@ class CoordinatorNode(object):
         msg.header.stamp = now
         msg.header.frame_id = "map"
         msg.state, msg.reason, msg.formation, msg.spacing = c.state(), c.reason, c.formation, c.spacing
-        msg.leader, msg.members, msg.lost, msg.paused = c.leader, list(c.members), list(c.lost), c.paused
+        msg.leader, msg.lost, msg.paused = c.leader, list(c.lost), c.paused
+        msg.members = sorted(c.members, key=lambda r: r != c.leader)   # the leader first, as the message says
         if c.target is not None:
             msg.has_target = True
             msg.target.x, msg.target.y, msg.target.theta = c.target

@@ -2,6 +2,7 @@
 import pytest
 import rospy
 
+from mbot_follower import fleet_io
 from mbot_follower.fleet_io import quiet_at_shutdown
 
 
@@ -22,3 +23,85 @@ def test_the_same_error_while_the_node_runs_is_raised(monkeypatch):
 
 def test_a_cycle_gets_its_arguments_and_returns_its_result():
     assert quiet_at_shutdown(lambda event: event * 2)(21) == 42
+
+
+# --- lookup_pose: the newest transform, never an old one ----------------------------------------
+
+def _buffer_with(*transforms):
+    import tf2_ros
+
+    buffer = tf2_ros.Buffer(debug=False)
+    for t in transforms:
+        buffer.set_transform(t, "test")
+    return buffer
+
+
+def _transform(parent, child, stamp, x=0.0, y=0.0, yaw=0.0):
+    import math
+
+    from geometry_msgs.msg import TransformStamped
+
+    t = TransformStamped()
+    t.header.stamp = rospy.Time.from_sec(stamp)
+    t.header.frame_id, t.child_frame_id = parent, child
+    t.transform.translation.x, t.transform.translation.y = x, y
+    t.transform.rotation.z, t.transform.rotation.w = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+    return t
+
+
+def test_lookup_pose_takes_the_newest_transform_through_the_chain():
+    import math
+
+    buffer = _buffer_with(_transform("map", "r/odom", 10.0, x=1.0), _transform("map", "r/odom", 10.1, x=1.0),
+                          _transform("r/odom", "r/base_link", 10.0, y=2.0, yaw=0.5),
+                          _transform("r/odom", "r/base_link", 10.05, y=2.0, yaw=0.5))
+    pose, stamp = fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(10.1), 0.1)
+    assert math.isclose(pose.x, 1.0) and math.isclose(pose.y, 2.0) and math.isclose(pose.theta, 0.5)
+    assert math.isclose(stamp.to_sec(), 10.05)   # the newest time both links know
+
+
+def test_lookup_pose_refuses_an_old_transform_and_an_unknown_frame():
+    buffer = _buffer_with(_transform("map", "r/base_link", 10.0))
+    with pytest.raises(fleet_io.StalePose, match=r"map -> r/base_link: newest transform is 0.15 s old \(limit 0.10"):
+        fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(10.15), 0.1)
+    with pytest.raises(fleet_io.StalePose, match="map -> q/base_link"):
+        fleet_io.lookup_pose(buffer, "map", "q/base_link", rospy.Time.from_sec(10.0), 0.1)
+
+
+def test_lookup_pose_polls_in_wall_time_for_a_transform_on_its_way():
+    import threading
+    import time
+
+    buffer = _buffer_with(_transform("map", "r/base_link", 10.0))
+    late = threading.Timer(0.1, lambda: buffer.set_transform(_transform("map", "r/base_link", 10.2, x=3.0), "test"))
+    late.start()
+    started = time.time()
+    pose, stamp = fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(10.2), 0.1, wall_wait=2.0)
+    late.join()
+    assert pose.x == 3.0 and abs(stamp.to_sec() - 10.2) < 1e-6
+    assert time.time() - started < 1.0
+    with pytest.raises(fleet_io.StalePose):   # nothing new comes: refused once the wait is over
+        fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(11.0), 0.1, wall_wait=0.05)
+
+
+def test_the_follower_holds_still_and_counts_a_failure_on_an_old_pose(monkeypatch):
+    """follower_node's cycle with only a 0.3 s old transform: no command but zero, state no_pose."""
+    from mbot_follower import follower_node
+    from mbot_follower.fleet_io import Assignment
+
+    f = follower_node.FollowerController.__new__(follower_node.FollowerController)
+    f.robot, f.fleet_state, f.paused = "follower_1", "NAVIGATING", False
+    f.params = {"max_pose_age": 0.1, "pose_wait": 0.0, "param_refresh": 1e9}
+    f._last_param_read = rospy.Time.from_sec(10.0)
+    f.assignment = Assignment("leader", "line", 1.5, {"leader": (0.0, 0.0), "follower_1": (0.0, -1.5)}, {})
+    f.tf_buffer = _buffer_with(_transform("map", "leader/base_link", 10.0),
+                               _transform("map", "follower_1/base_link", 10.0, y=-1.5))
+    f.lookups = f.lookup_failures = 0
+    sent, states = [], []
+    f._send = sent.append
+    f.filter = follower_node.CommandFilter(follower_node.ControllerConfig())
+    f._publish_state = lambda now, mode, *args, **kwargs: states.append(mode)
+    monkeypatch.setattr(rospy.Time, "now", staticmethod(lambda: rospy.Time.from_sec(10.3)))
+    f._cycle(None)
+    assert states == ["no_pose"] and (f.lookups, f.lookup_failures) == (1, 1)
+    assert sent and all((c.vx, c.vy, c.wz) == (0.0, 0.0, 0.0) for c in sent)
