@@ -14,7 +14,10 @@ The check is chosen by the private parameter ~check (one .test file per check):
   corridor  - 4 robots diamond -> column -> diamond through the corridor, no contact
   leader_loss - the leader is removed from the simulator: a follower takes over, the fleet ARRIVES
   rejoin    - a follower removed and spawned again rejoins a slot
-  refuse    - unknown formation, NaN target, target in a wall: refused, state unchanged
+  refuse    - unknown formation, NaN target, target in a wall: refused, state unchanged (also
+              through the /fleet/goal action: ABORTED with the reason); then the fleet drives on
+              /fleet/target_pose and by the action (feedback), the latched /fleet/assignment,
+              the live /fleet/metrics and ~debug_mode's slot errors in cm and degrees are there
 Everything waits in sim time with a wall-clock bound.
 """
 import math
@@ -24,6 +27,7 @@ import unittest
 
 import rospy
 import rostest
+from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import Pose2D as Pose2DMsg
 from std_msgs.msg import String
 
@@ -342,8 +346,70 @@ class FormationChecks(unittest.TestCase):
         p.formation_pub.publish(String("hexagon"))
         p.wait(lambda: "hexagon" in p.status.reason, 10.0, "the refusal of hexagon in the status")
         self.assertEqual(p.state(), "IDLE")
-        # and the fleet still works afterwards
-        self.drive_and_arrive(2.0, 0.0)
+        client = self.fleet_goal_client()
+        result = self.fleet_goal(client, 9.95, 0.0)
+        self.assertEqual(client.get_state(), GoalStatus.ABORTED)
+        self.assertFalse(result.success)
+        self.assertIn("in a wall", result.message)
+        self.assertEqual(p.state(), "IDLE")
+        # and the fleet still works afterwards: on /fleet/target_pose, then by the action
+        debug_lines = self.collect_debug_lines()
+        target_pub = rospy.Publisher("/fleet/target_pose", Pose2DMsg, queue_size=1, latch=True)
+        target_pub.publish(Pose2DMsg(2.0, 0.0, 0.0))
+        p.wait(lambda: p.state() in ("FORMING", "NAVIGATING"), 10.0, "the goal on /fleet/target_pose")
+        p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 180.0, "ARRIVED")
+        self.assertEqual(p.state(), "ARRIVED", p.status.reason)
+        self.leader_at(2.0, 0.0)
+        feedback = []
+        result = self.fleet_goal(client, 3.5, 0.0, feedback)
+        self.assertTrue(result.success, result.message)
+        self.leader_at(3.5, 0.0)
+        self.assertIn("NAVIGATING", [f.state for f in feedback])
+        self.assertTrue(any(0.0 < f.distance_to_goal < 1.6 and math.isfinite(f.rms_error) for f in feedback),
+                        "no feedback with the distance to the goal and the slot error")
+        self.check_outputs(debug_lines)
+
+    def fleet_goal_client(self):
+        import actionlib
+        from mbot_msgs.msg import FleetGoalAction
+
+        client = actionlib.SimpleActionClient("/fleet/goal", FleetGoalAction)
+        self.assertTrue(client.wait_for_server(rospy.Duration(30.0)), "no /fleet/goal action server")
+        return client
+
+    def fleet_goal(self, client, x, y, feedback=None):
+        """Send the action goal (x, y) and wait (in sim time, with a wall bound) for its result."""
+        from mbot_msgs.msg import FleetGoalGoal
+
+        client.send_goal(FleetGoalGoal(target=Pose2DMsg(x, y, 0.0)),
+                         feedback_cb=feedback.append if feedback is not None else None)
+        self.probe.wait(lambda: client.get_state() not in (GoalStatus.PENDING, GoalStatus.ACTIVE), 180.0,
+                        "the result of the goal (%.1f, %.1f)" % (x, y))
+        return client.get_result()
+
+    def collect_debug_lines(self):
+        from rosgraph_msgs.msg import Log
+
+        lines = []
+        rospy.Subscriber("/rosout", Log, lambda m: lines.append(m.msg) if "slot error" in m.msg else None,
+                         queue_size=100)
+        return lines
+
+    def check_outputs(self, debug_lines):
+        """What a student looks at: the latched assignment (a late subscriber gets it), the live
+        metrics, and ~debug_mode's slot errors (this test's launch sets it)."""
+        from mbot_msgs.msg import FleetAssignment, FleetMetrics
+
+        latched = rospy.wait_for_message("/fleet/assignment", FleetAssignment, 10.0)
+        self.assertEqual(latched.formation, self.probe.assignment.formation)
+        self.assertEqual(latched.leader, "leader")
+        metrics = rospy.wait_for_message("/fleet/metrics", FleetMetrics, 10.0)
+        self.assertEqual((metrics.state, metrics.contacts), ("ARRIVED", 0))
+        self.assertTrue(math.isfinite(metrics.slot_rms), metrics.slot_rms)
+        self.assertGreater(metrics.distance, 3.0)   # the leader alone drove 3.5 m
+        for robot in ("follower_1", "follower_2"):
+            self.assertTrue([line for line in debug_lines if robot + " slot error" in line and " cm, " in line
+                             and line.endswith(" deg")], "no debug_mode line for %s in %s" % (robot, debug_lines[-4:]))
 
 
 if __name__ == "__main__":
