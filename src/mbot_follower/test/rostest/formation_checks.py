@@ -5,7 +5,8 @@ from the simulator's ground truth (not from what the coordinator says about itse
 
 The check is chosen by the private parameter ~check (one .test file per check):
   triangle  - the triangle drives to (5, 0) via /simulation/target_pose: slot RMS while moving
-              < 0.15 m, ARRIVED, no contact (~formation, ~topology: another shape, a chain)
+              < 0.15 m, ARRIVED, no contact (~formation, ~topology: another shape, a chain;
+              ~omni: the followers are omni robots and must drive sideways too)
   obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
   switch    - switch to `line` while moving: the line is reached; then to `column`: the leader
               drives faster until the column is there, then at its usual speed again
@@ -14,6 +15,8 @@ The check is chosen by the private parameter ~check (one .test file per check):
   corridor  - 4 robots diamond -> column -> diamond through the corridor, no contact
   leader_loss - the leader is removed from the simulator: a follower takes over, the fleet ARRIVES
   rejoin    - a follower removed and spawned again rejoins a slot
+  wall      - a line abreast along the north wall: the slot beyond the wall is not chased into it
+              (its follower follows the leader's path), no contact; it is taken again once free
   refuse    - unknown formation, NaN target, target in a wall: refused, state unchanged (also
               through the /fleet/goal action: ABORTED with the reason); then the fleet drives on
               /fleet/target_pose and by the action (feedback), the latched /fleet/assignment,
@@ -89,7 +92,12 @@ class FormationChecks(unittest.TestCase):
     def run_triangle(self):
         p = self.probe
         self.assertEqual(p.state(), "IDLE")
+        sideways = self.record_sideways_commands() if rospy.get_param("~omni", False) else None
         self.drive_and_arrive(5.0, 0.0)
+        if sideways is not None:   # omni followers run the omni law: they drive sideways too
+            rospy.loginfo("triangle: largest sideways command per follower %s", sideways)
+            for robot, largest in sideways.items():
+                self.assertGreater(largest, 0.05, "%s never drove sideways (max |vy| %.3f m/s)" % (robot, largest))
         self.assertEqual(p.assignment.formation, rospy.get_param("~formation", "triangle"))
         if rospy.get_param("~topology", "star") == "chain":
             # the last robot of the chain tracks the one ahead of it, not the leader
@@ -108,6 +116,20 @@ class FormationChecks(unittest.TestCase):
         self.assertLess(max(final.values()), 0.3, "final slot errors %s" % final)
         self.assertNoContacts()
         self.check_view_frame()
+
+    def record_sideways_commands(self):
+        """{follower: largest |linear.y| [m/s] it was commanded so far} (a diff-drive law sends 0)."""
+        from geometry_msgs.msg import Twist
+
+        largest = {}
+
+        def on_cmd(msg, robot):
+            largest[robot] = max(largest[robot], abs(msg.linear.y))
+
+        for robot in robots_param()[1:]:
+            largest[robot] = 0.0
+            rospy.Subscriber("/%s/cmd_vel" % robot, Twist, on_cmd, callback_args=robot, queue_size=50)
+        return largest
 
     def check_view_frame(self):
         """The coordinator's `fleet` frame (rviz follows it) is the middle of the resting fleet."""
@@ -327,6 +349,39 @@ class FormationChecks(unittest.TestCase):
         rospy.loginfo("rejoin: back in formation %.1f s after the respawn", rospy.get_time() - t_back)
         self.assertNoContacts()
 
+    def run_wall(self):
+        from mbot_msgs.msg import FollowerState
+
+        p = self.probe
+        north_y = 10.0 - 0.4   # the room's north wall (inner face) less a robot's size
+        modes = {}             # follower -> its controller's modes while its slot lay beyond the wall
+
+        def on_state(msg):
+            a = p.assignment
+            with p.lock:
+                slots = p._slot_poses({r: v[1] for r, v in p.truth.items()}, a)
+            if msg.robot in slots and slots[msg.robot].y > north_y:
+                modes.setdefault(msg.robot, []).append(msg.mode)
+
+        for robot in robots_param()[1:]:
+            rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, on_state, queue_size=20)
+        p.formation_pub.publish(String("line"))
+        p.wait(lambda: p.assignment is not None and p.assignment.formation == "line", 10.0, "the line")
+        # the leader 1.8 m from the wall, facing east: its left slot (2.5 m) lies beyond the wall
+        self.drive_and_arrive(0.0, 8.2)
+        self.assertTrue(modes, "no slot lay beyond the wall")
+        for robot, seen in modes.items():
+            rospy.loginfo("wall: %s's modes while its slot lay beyond the wall: %s", robot,
+                          {m: seen.count(m) for m in set(seen)})
+            self.assertIn("trail", seen, "%s chased its slot beyond the wall" % robot)
+            self.assertLess(p.truth[robot][1].y, north_y, "%s went into the wall" % robot)
+        self.assertNoContacts()
+        # away from the wall the slot is free again: taken again
+        self.drive_and_arrive(5.0, 2.0)
+        final = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
+        self.assertLess(max(final.values()), 0.3, "final slot errors %s" % final)
+        self.assertNoContacts()
+
     def run_refuse(self):
         from mbot_msgs.srv import SetFormation
 
@@ -379,11 +434,13 @@ class FormationChecks(unittest.TestCase):
 
     def fleet_goal(self, client, x, y, feedback=None):
         """Send the action goal (x, y) and wait (in sim time, with a wall bound) for its result."""
+        from actionlib import SimpleGoalState
         from mbot_msgs.msg import FleetGoalGoal
 
         client.send_goal(FleetGoalGoal(target=Pose2DMsg(x, y, 0.0)),
                          feedback_cb=feedback.append if feedback is not None else None)
-        self.probe.wait(lambda: client.get_state() not in (GoalStatus.PENDING, GoalStatus.ACTIVE), 180.0,
+        # DONE once the result itself is here (the status array may say SUCCEEDED before it)
+        self.probe.wait(lambda: client.simple_state == SimpleGoalState.DONE, 180.0,
                         "the result of the goal (%.1f, %.1f)" % (x, y))
         return client.get_result()
 

@@ -1,4 +1,5 @@
-"""formation_fleet's generated launch lines without ROS: one controller per robot, its settings."""
+"""formation_fleet's generated launch lines without ROS: one controller per robot, its settings;
+and formation.launch's parameters for the coordinator (roslaunch --dump-params, no node runs)."""
 import os
 import xml.etree.ElementTree as ET
 
@@ -40,3 +41,21 @@ def test_lockstep_refuses_anything_else(capsys):
     with pytest.raises(SystemExit):
         parse_args(["--world", "trio", "--lockstep", "maybe"])
     assert "expected true or false, got 'maybe'" in capsys.readouterr().err
+
+
+def test_formation_launch_hands_leader_and_lockstep_to_the_coordinator():
+    """`roslaunch mbot_follower formation.launch leader:=NAME lockstep:=true`, its parameters
+    only (roslaunch --dump-params starts no node)."""
+    import subprocess
+
+    import yaml
+
+    def coordinator_params(*args):
+        out = subprocess.check_output(["roslaunch", "--dump-params", "mbot_follower", "formation.launch"] + list(args),
+                                      universal_newlines=True)
+        return {k.split("/")[-1]: v for k, v in yaml.safe_load(out).items() if k.startswith("/coordinator/")}
+
+    default = coordinator_params()
+    assert (default["leader"], default["lockstep"]) == ("", False)   # the world's first robot leads
+    chosen = coordinator_params("leader:=follower_2", "lockstep:=true")
+    assert (chosen["leader"], chosen["lockstep"]) == ("follower_2", True)
