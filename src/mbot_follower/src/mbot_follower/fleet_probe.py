@@ -152,6 +152,11 @@ class FleetProbe(object):
         return {s.robot: slot_pose(poses[assignment.leader], (s.offset.x, s.offset.y), trail)
                 for s in assignment.slots}
 
+    def slot_poses(self, poses, assignment):
+        """{robot: Pose2D} of an assignment's slots placed for the leader's pose in `poses`."""
+        with self.lock:
+            return self._slot_poses(poses, assignment)
+
     def slot_errors(self, poses, assignment):
         """{follower: distance to its slot} from ground truth poses and an assignment: a sample's
         (its slots as placed then) or the message (its slots placed now)."""

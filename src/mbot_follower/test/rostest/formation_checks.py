@@ -357,9 +357,7 @@ class FormationChecks(unittest.TestCase):
         modes = {}             # follower -> its controller's modes while its slot lay beyond the wall
 
         def on_state(msg):
-            a = p.assignment
-            with p.lock:
-                slots = p._slot_poses({r: v[1] for r, v in p.truth.items()}, a)
+            slots = p.slot_poses({r: v[1] for r, v in p.truth.items()}, p.assignment)
             if msg.robot in slots and slots[msg.robot].y > north_y:
                 modes.setdefault(msg.robot, []).append(msg.mode)
 
