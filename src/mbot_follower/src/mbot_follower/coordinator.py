@@ -324,7 +324,11 @@ class FleetCoordinator(object):
                 self.events.append((now, "resume", self.reason))
                 actions.append(("goal", self.leader, self.target))
             return actions
-        if obstacle_ahead and now >= self._no_pause_before and self._leader_done_at is None:
+        # A leader that waits for its followers (regrouping) has no goal: a follower passing in
+        # front of it on the way to its slot is no reason to pause, and the pause's end would
+        # send the leader off into the followers still taking their slots.
+        if obstacle_ahead and now >= self._no_pause_before and self._leader_done_at is None \
+                and self._regroup_since is None:
             self.paused = True
             self._switch_fast = False
             self._pause_until = now + self.config.pause_time

@@ -374,7 +374,8 @@ class FormationChecks(unittest.TestCase):
             self.assertIn("trail", seen, "%s chased its slot beyond the wall" % robot)
             self.assertLess(p.truth[robot][1].y, north_y, "%s went into the wall" % robot)
         self.assertNoContacts()
-        # away from the wall the slot is free again: taken again
+        # back south-east, away from the wall: the slot is free again and taken again. The leader
+        # turns across its trailing follower, which must pass in front of it to its new slot.
         self.drive_and_arrive(5.0, 2.0)
         final = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
         self.assertLess(max(final.values()), 0.3, "final slot errors %s" % final)

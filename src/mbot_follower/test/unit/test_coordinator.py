@@ -399,6 +399,28 @@ def test_the_leader_waits_for_a_follower_far_off_its_slot():
     assert actions == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
 
 
+def test_a_follower_passing_in_front_of_the_waiting_leader_does_not_pause_or_send_it_off():
+    """trio_wall found it: while the leader waited (regrouping), a follower on its way to its
+    slot passed in front of it; the fleet paused, and the pause's end sent the leader its goal
+    while the followers were still taking their slots (a contact, 2 runs in 10)."""
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    p = poses["follower_1"]
+    off["follower_1"] = Pose2D(p.x - 1.0, p.y, p.theta)
+    assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
+    sent = []
+    for i in range(30):   # 3 s with something in front of the waiting leader
+        t += 0.1
+        sent += core.update(t + 0.1, off, heard(t + 0.1), leader_nav=None, obstacle_ahead=True)
+    assert sent == [] and not core.paused and "regrouping" in core.reason
+    # the follower is back: the leader drives on; then an obstacle in front of it pauses it
+    resumed = core.update(t + 0.2, poses, heard(t + 0.2), leader_nav=None)
+    assert resumed == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
+    paused = core.update(t + 0.3, poses, heard(t + 0.3), leader_nav="ACTIVE", obstacle_ahead=True)
+    assert paused == [("cancel", "leader")] and core.paused
+
+
 def test_a_follower_on_the_trail_does_not_hold_up_the_leader():
     core = make()
     t, poses, _ = formed_and_navigating(core)
