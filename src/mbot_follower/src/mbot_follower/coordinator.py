@@ -20,7 +20,8 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
 would not bring them closer. While the leader waits, an excuse counts once it has lasted
 ``excuse_time``: a follower turning away from a wall is held by its safety layer for a moment,
-and that moment must not send the leader off without it.
+and that moment must not send the leader off without it. A waiting leader is never paused (it
+has no goal): a follower passing in front of it to its slot is not an obstacle to go around.
 
 Except right after a formation switch on the move: the followers change places, and on the way they
 block each other (the safety layer holds one, or another robot blocks its way to the slot and it
