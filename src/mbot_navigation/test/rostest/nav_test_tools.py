@@ -49,6 +49,7 @@ class Track(object):
     def __init__(self, robot, history=False):
         self._lock = threading.Lock()
         self.pose = None       # (x, y, yaw)
+        self.stamp = None      # [s sim] of pose
         self.length = 0.0      # [m] since reset()
         self.total = 0.0       # [m] since the first sample
         self.history = {} if history else None
@@ -65,6 +66,7 @@ class Track(object):
                 self.length += step
                 self.total += step
             self.pose = (p.x, p.y, yaw)
+            self.stamp = msg.header.stamp.to_sec()
             if self.history is not None:
                 self.history[msg.header.stamp.to_nsec()] = (p.x, p.y, yaw, self.total)
 
@@ -74,6 +76,12 @@ class Track(object):
 
     def wait(self, timeout=60.0):
         wait_until(lambda: self.pose is not None, timeout, "the robot's ground truth")
+        return self.pose
+
+    def pose_since(self, t, timeout=10.0):
+        """The first pose stamped at sim time t or later: a busy test process receives the
+        ground truth late, and the newest pose it has may show the robot still turning."""
+        wait_until(lambda: self.stamp is not None and self.stamp >= t, timeout, "the ground truth of t = %.2f s" % t)
         return self.pose
 
 

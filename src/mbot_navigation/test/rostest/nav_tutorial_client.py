@@ -3,7 +3,10 @@
 'robot_1/move_base', wait_for_server, send_goal, wait_for_result), then a goal on
 robot_1/move_base_simple/goal as rviz's "2D Nav Goal" sends it. The client logs no error (a
 server that accepted goals inside its goal callback made it log "Got a transition callback on a
-goal handle that we're not tracking")."""
+goal handle that we're not tracking"). That message also comes from a race inside the client
+itself (actionlib issue #206: a status may arrive before send_goal has stored its goal handle),
+which a loaded machine can trigger with any server: one such message in the six goals is
+tolerated, a server that makes it likely is not."""
 import logging
 import math
 import unittest
@@ -63,12 +66,14 @@ class TutorialClient(unittest.TestCase):
             again = [movebase_client() for _ in range(5)]
         finally:
             logging.getLogger("rosout").removeHandler(errors)
-        self.assertEqual(errors.records, [])
+        client_race = "Got a transition callback on a goal handle that we're not tracking"
+        self.assertEqual([e for e in errors.records if e != client_race], [])
+        self.assertLessEqual(errors.records.count(client_race), 1, errors.records)
         for _, state2, text2 in again:
             self.assertEqual(state2, GoalStatus.SUCCEEDED, text2)
         self.assertIsNotNone(result)
         self.assertEqual(state, GoalStatus.SUCCEEDED, text)
-        x, y, yaw = track.pose
+        x, y, yaw = track.pose_since(rospy.get_time())
         self.assertLess(math.hypot(x - 3.0, y - 4.0), 0.15, track.pose)
         self.assertLess(angle_diff(yaw, 0.0), 0.15, track.pose)
 
@@ -76,8 +81,12 @@ class TutorialClient(unittest.TestCase):
         track = Track("robot_1")
         statuses = {}  # goal id -> latest status
         arrays = []  # every status message's sim time
+        succeeded_at = {}  # goal id -> stamp [s sim] of the first status message saying SUCCEEDED
 
         def on_status(msg):
+            for s in msg.status_list:   # before `statuses`, which the test waits on
+                if s.status == GoalStatus.SUCCEEDED:
+                    succeeded_at.setdefault(s.goal_id.id, msg.header.stamp.to_sec())
             statuses.update((s.goal_id.id, s.status) for s in msg.status_list)
             arrays.append(rospy.get_time())
 
@@ -100,7 +109,8 @@ class TutorialClient(unittest.TestCase):
         new = lambda: {i: s for i, s in statuses.items() if i not in before}  # noqa: E731
         wait_until(lambda: len(new()) == 1, 5.0, "the goal to show up on robot_1/move_base/status")
         wait_until(lambda: GoalStatus.SUCCEEDED in new().values(), 90.0, "SUCCEEDED on robot_1/move_base/status")
-        x, y, yaw = track.pose
+        (goal_id,) = new()
+        x, y, yaw = track.pose_since(succeeded_at[goal_id])
         self.assertLess(math.hypot(x - 3.0, y - 7.5), 0.15, track.pose)
         self.assertLess(angle_diff(yaw, math.pi / 2), 0.15, track.pose)
 
