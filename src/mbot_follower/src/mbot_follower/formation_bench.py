@@ -109,13 +109,14 @@ SETTLE = 3.0                    # [s] after NAVIGATING, before the straight run 
 def moving_rms(run, since, until):
     """The followers' slot error RMS [m] over the record's samples since <= t < until in which the
     fleet navigates (NAVIGATING, DEGRADED) and the leader moves; None if there are none."""
-    from mbot_follower.metrics import PLAN_STATES, leader_speed
+    from mbot_follower.metrics import PLAN_STATES, finite_rms, leader_speed
 
     errors = []
     for before, s in zip(run.samples, run.samples[1:]):
         if since <= s.t < until and s.state in PLAN_STATES and leader_speed(before, s) >= MOVING:
-            errors += [rs.slot_error for rs in s.robots.values() if math.isfinite(rs.slot_error)]
-    return round(math.sqrt(sum(e * e for e in errors) / len(errors)), 4) if errors else None
+            errors += [rs.slot_error for rs in s.robots.values()]
+    rms = finite_rms(errors)
+    return None if rms is None else round(rms, 4)
 
 
 def timings(run, route=None):

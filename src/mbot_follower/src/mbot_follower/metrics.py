@@ -409,7 +409,7 @@ def _finite(values):
     return v[np.isfinite(v)]
 
 
-def _rms(values):
+def finite_rms(values):
     """RMS of the finite values; None when there are none."""
     v = _finite(values)
     return _number(np.sqrt(np.mean(v * v))) if len(v) else None
@@ -421,7 +421,7 @@ def _stats(values, prefix, unit, rms=False, percentiles=()):
     v = _finite(values)
     out = {}
     if rms:
-        out["%s_rms_%s" % (prefix, unit)] = _rms(v)
+        out["%s_rms_%s" % (prefix, unit)] = finite_rms(v)
     for p in percentiles:
         out["%s_p%d_%s" % (prefix, p, unit)] = _number(np.percentile(v, p)) if len(v) else None
     out["%s_max_%s" % (prefix, unit)] = _number(np.max(v)) if len(v) else None
@@ -571,8 +571,8 @@ def summarize(run):
     fleet = {"slot_samples": len(_finite(pooled_slot))}
     fleet.update(_stats(pooled_slot, "slot", "m", rms=True, percentiles=(95,)))
     fleet.update(_stats(pooled_fit, "fit", "m", rms=True, percentiles=(95,)))
-    fleet["steady_navigating_slot_rms_m"] = _rms(navigating)
-    fleet["steady_arrived_slot_rms_m"] = _rms(arrived)
+    fleet["steady_navigating_slot_rms_m"] = finite_rms(navigating)
+    fleet["steady_arrived_slot_rms_m"] = finite_rms(arrived)
     fleet["slot_blocked_share"] = blocked_samples / moving_samples if moving_samples else None
     lateral = [s.leader_lateral for s in run.samples if s.state in PLAN_STATES]
     fleet.update(_stats(lateral, "leader_lateral", "m", rms=True))
