@@ -5,6 +5,7 @@ import math
 from mbot_common.geometry import Pose2D
 from mbot_follower.coordinator import CoordinatorConfig, FleetCoordinator
 from mbot_follower.markers import fleet_markers
+from test_coordinator import formed_and_navigating, heard
 
 ROBOTS = ["leader", "follower_1", "follower_2"]
 
@@ -67,3 +68,18 @@ def test_the_state_is_written_above_every_robot():
     assert state.pose.position.y > max(p.y for p in poses.values()) + 0.5
     xs = [p.x for p in poses.values()]
     assert min(xs) <= state.pose.position.x <= max(xs)
+
+
+def test_a_paused_fleet_shows_a_red_cylinder_in_front_of_the_leader():
+    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, CoordinatorConfig())
+    t, poses, _ = formed_and_navigating(core)
+    leader = poses["leader"]
+    assert "pause" not in by_ns(fleet_markers(core, poses, stamp()))
+    core.update(t + 0.1, poses, heard(t + 0.1), leader_nav="ACTIVE", obstacle_ahead=True)
+    assert core.paused
+    found = by_ns(fleet_markers(core, poses, stamp()))
+    warn = found["pause"][0]
+    assert (warn.color.r, warn.color.g < 0.3, warn.color.b < 0.3) == (1.0, True, True)
+    ahead = (warn.pose.position.x - leader.x, warn.pose.position.y - leader.y)
+    assert ahead[0] * math.cos(leader.theta) + ahead[1] * math.sin(leader.theta) > 0.5
+    assert "PAUSED" in found["state"][0].text and found["state"][0].color.g < 0.3
