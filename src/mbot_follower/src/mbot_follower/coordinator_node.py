@@ -334,8 +334,8 @@ class CoordinatorNode(object):
             for robot in sorted(set(self.core.lost) - lost_before):
                 rospy.logwarn("coordinator: %s unheard: newest pose %.2f s old, controller state %.2f s old "
                               "(all poses %.2f s behind, all controller states %.2f s behind)", robot,
-                              now - self.last_heard_pose.get(robot, -1e9),
-                              now - self.last_heard_controller.get(robot, -1e9), pose_lag, controller_lag)
+                              _age(self.last_heard_pose.get(robot), now),
+                              _age(self.last_heard_controller.get(robot), now), pose_lag, controller_lag)
             # the assignment and the status of one decision carry its time: a metrics sample
             # between two stamps would see the new slots under the old state
             self._run(actions, now_ros)
@@ -509,6 +509,12 @@ class NavSpeedLimit(object):
         if speed > self._usual[robot]:
             client.update_configuration({"max_vel_x": speed})
             rospy.loginfo("coordinator: %s navigates at up to %.2f m/s through the switch", robot, speed)
+
+
+def _age(stamp, now):
+    """Seconds since `stamp` for a log line: a transform stamped after this cycle's clock reading
+    (sim time moved on meanwhile) is 0 s old, not -0.25 s; never heard is infinitely old."""
+    return float("inf") if stamp is None else max(0.0, now - stamp)
 
 
 def _lag(stamps, now):

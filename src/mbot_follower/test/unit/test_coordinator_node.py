@@ -6,7 +6,7 @@ import time
 import rospy
 
 from mbot_follower.coordinator import FleetCoordinator
-from mbot_follower.coordinator_node import NODE_PARAMS, CoordinatorNode
+from mbot_follower.coordinator_node import NODE_PARAMS, CoordinatorNode, _age
 
 ROBOTS = ["robot_0", "robot_1", "robot_2"]
 NOW = 100.0
@@ -77,3 +77,8 @@ def test_a_lost_robot_is_not_waited_for():
     n.core.members.remove("robot_1")
     n.core.lost.append("robot_1")
     assert timed_wait(n) < 0.05
+
+
+def test_the_loss_log_gives_no_negative_ages():
+    # a pose stamped after the cycle read its clock is current, not -0.25 s old
+    assert (_age(100.25, 100.0), _age(98.9, 100.0), _age(None, 100.0)) == (0.0, 100.0 - 98.9, float("inf"))
