@@ -153,6 +153,13 @@ class Run(object):
         self.events = []       # Event
         self.controller = []   # ControllerSample
 
+    def snapshot(self):
+        """A copy that later appends do not change (the entries themselves are immutable)."""
+        copy = Run(self.config)
+        copy.robots, copy.samples = list(self.robots), list(self.samples)
+        copy.events, copy.controller = list(self.events), list(self.controller)
+        return copy
+
 
 def distance_to_polyline(x, y, points):
     """Distance [m] of the point (x, y) from the polyline through points (n, 2), n >= 1."""

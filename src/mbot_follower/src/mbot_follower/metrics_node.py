@@ -31,7 +31,7 @@ from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
 from mbot_follower.fleet_io import assignment_from_msg, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
-from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter
+from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter, summarize
 
 #: Node parameters that are not MetricsConfig fields: name -> (kind, default).
 NODE_PARAMS = {
@@ -71,7 +71,12 @@ class MetricsNode(object):
         self.collector = MetricsCollector(config)
         self.writer = RunWriter(output_dir) if output_dir else None
         self.fixed_robots = bool(robots)
-        self.lock = threading.Lock()   # the subscribers' threads and the timers share the collector
+        # The subscribers' threads and the timers share the collector. The summary of a long run
+        # takes a tenth of a CPU second, seconds of wall time on a loaded machine: it is computed
+        # on a snapshot outside this lock. Held that long, the lock stalled the heartbeat, the
+        # simulator's lockstep went on without this node, and its samples lacked poses.
+        self.lock = threading.Lock()
+        self.write_lock = threading.Lock()   # one writer at a time, the newest record last
         self.closed = False
         self.subs = {}
         self.pub = rospy.Publisher("/fleet/metrics", FleetMetrics, queue_size=1)
@@ -176,9 +181,9 @@ class MetricsNode(object):
 
     def publish(self, _event=None):
         with self.lock:
-            summary = self.collector.summary()
+            run = self.collector.run.snapshot()
             state = self.collector.state
-        fleet = summary["fleet"]
+        fleet = summarize(run)["fleet"]
 
         def number(key):
             return float("nan") if fleet[key] is None else fleet[key]
@@ -202,7 +207,10 @@ class MetricsNode(object):
         if self.writer is None:
             return
         with self.lock:
-            self._write()
+            run = self.collector.run.snapshot()
+        with self.write_lock:
+            if not self.closed:   # else finish() writes (or wrote) a newer record
+                self._write(run)
 
     def finish(self):
         """At shutdown: the last write, then no more messages."""
@@ -210,15 +218,17 @@ class MetricsNode(object):
             if self.closed:
                 return
             self.closed = True
-            if self.writer is not None and self._write():
-                rospy.loginfo("%s: %d samples written to %s", rospy.get_name(), len(self.collector.run.samples),
+            run = self.collector.run.snapshot()
+        with self.write_lock:
+            if self.writer is not None and self._write(run):
+                rospy.loginfo("%s: %d samples written to %s", rospy.get_name(), len(run.samples),
                               self.writer.output_dir)
 
-    def _write(self):
+    def _write(self, run):
         """Write the record; a folder that is gone (a test removed it as the run ended) or full is
         an error naming it, not a crash of the collector. Returns whether it was written."""
         try:
-            self.writer.write(self.collector.run, self.collector.summary())
+            self.writer.write(run, summarize(run))
             return True
         except OSError as error:
             rospy.logerr_throttle(10.0, "%s: cannot write the record to %s: %s" % (

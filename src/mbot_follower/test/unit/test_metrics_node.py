@@ -1,0 +1,75 @@
+"""The metrics node's locking (no master needed: the node is built without its ROS connections).
+The summary of a long run is slow on a loaded machine; computed under the lock that the pose
+callbacks need, it stalled the lockstep heartbeat and the simulator went on without the node."""
+import json
+import os
+import threading
+
+from mbot_follower import metrics_node
+from mbot_follower.metrics import MetricsCollector, RunWriter
+
+from test_metrics import drive, wedge
+
+
+class Publisher(object):
+    def __init__(self):
+        self.sent = []
+
+    def publish(self, msg):
+        self.sent.append(msg)
+
+
+def node(output_dir):
+    n = metrics_node.MetricsNode.__new__(metrics_node.MetricsNode)
+    n.collector = MetricsCollector()
+    n.writer = RunWriter(output_dir)
+    n.lock, n.write_lock = threading.Lock(), threading.Lock()
+    n.closed = False
+    n.pub = Publisher()
+    n.collector.on_assignment(0.0, wedge())
+    n.collector.on_status(0.0, "NAVIGATING", "goal", [])
+    feed(n, 0.0, 2.0)
+    return n
+
+
+def feed(n, t_from, t_to):
+    def poses(t):
+        return {"robot_0": (t, 0.0, 0.0), "robot_1": (t - 1.0, 0.5, 0.0), "robot_2": (t - 1.0, -0.5, 0.0)}
+
+    drive(n.collector, t_from, t_to, poses)
+
+
+def summarized_without_the_lock(n, monkeypatch, call):
+    """Run call() with a summarize that notes whether the node's lock was free meanwhile."""
+    free = []
+    real = metrics_node.summarize
+
+    def watching(run):
+        got = n.lock.acquire(blocking=False)
+        if got:
+            n.lock.release()
+        free.append(got)
+        return real(run)
+
+    monkeypatch.setattr(metrics_node, "summarize", watching)
+    call()
+    return free
+
+
+def test_the_live_summary_is_computed_outside_the_lock(tmp_path, monkeypatch):
+    n = node(str(tmp_path))
+    monkeypatch.setattr(metrics_node.rospy.Time, "now", staticmethod(lambda: metrics_node.rospy.Time(2, 0)))
+    assert summarized_without_the_lock(n, monkeypatch, n.publish) == [True]
+    assert n.pub.sent[0].state == "NAVIGATING" and n.pub.sent[0].slot_rms < 0.01
+
+
+def test_the_record_is_written_outside_the_lock_and_a_save_after_finish_writes_nothing(tmp_path, monkeypatch):
+    n = node(str(tmp_path))
+    assert summarized_without_the_lock(n, monkeypatch, n.save) == [True]
+    assert summarized_without_the_lock(n, monkeypatch, n.finish) == [True]
+    with open(os.path.join(str(tmp_path), "metrics.json")) as f:
+        written = json.load(f)
+    feed(n, 2.0, 3.0)   # not through the callbacks, which ignore data after finish()
+    n.save()            # a timer that fires after finish() must not overwrite its record
+    with open(os.path.join(str(tmp_path), "metrics.json")) as f:
+        assert json.load(f) == written
