@@ -399,9 +399,6 @@ class MetricsCollector(object):
             self._trail_of = a
         self._trail.add(pose[0], pose[1])
 
-    def summary(self):
-        return summarize(self.run)
-
 
 # --- the summary ----------------------------------------------------------------------------
 

@@ -5,7 +5,7 @@ import math
 from mbot_common.geometry import Pose2D
 from mbot_follower.coordinator import CoordinatorConfig, FleetCoordinator
 from mbot_follower.markers import fleet_markers
-from test_coordinator import formed_and_navigating, heard
+from test_coordinator import formed_and_navigating, heard, make
 
 ROBOTS = ["leader", "follower_1", "follower_2"]
 
@@ -71,7 +71,7 @@ def test_the_state_is_written_above_every_robot():
 
 
 def test_a_paused_fleet_shows_a_red_cylinder_in_front_of_the_leader():
-    core = FleetCoordinator(ROBOTS, "leader", "triangle", 2.5, CoordinatorConfig())
+    core = make()
     t, poses, _ = formed_and_navigating(core)
     leader = poses["leader"]
     assert "pause" not in by_ns(fleet_markers(core, poses, stamp()))
