@@ -1,0 +1,161 @@
+/**
+ * @file stage_ros_robot_io.cpp
+ * @brief Each robot's topics: its publishers and subscribers, sensor samples -> messages, and
+ *        the commands it takes (cmd_vel, cmd_pose). See stage_ros.h.
+ */
+#include "mbot_sim/stage_ros.h"
+
+#include "stage_ros_internal.h"
+
+#include <mbot_msgs/Contact.h>
+
+#include <cmath>
+
+namespace mbot_sim
+{
+namespace
+{
+/// Fill pose and twist of an Odometry message.
+void fillOdometry(nav_msgs::Odometry& msg, double stamp, const Pose2D& pose, const Twist2D& twist)
+{
+  msg.header.stamp.fromSec(stamp);
+  msg.pose.pose.position.x = pose.x;
+  msg.pose.pose.position.y = pose.y;
+  msg.pose.pose.position.z = 0.0;
+  msg.pose.pose.orientation = yawToQuaternion(pose.theta);
+  msg.twist.twist.linear.x = twist.vx;
+  msg.twist.twist.linear.y = twist.vy;
+  msg.twist.twist.angular.z = twist.wz;
+}
+
+}  // namespace
+
+// =============================================================================================
+// a robot's topics
+
+void StageRos::addRobotIo(int id)
+{
+  auto io = std::make_unique<RobotIo>();
+  io->name = world_->robotName(id);
+  io->prefix = io->name + "/";
+  const std::string ns = io->name + "/";
+  // Queues of 100 (2 s at 50 Hz in real time): a subscriber that stalls briefly, or a fast
+  // real-time factor, does not lose messages.
+  io->odom = nh_.advertise<nav_msgs::Odometry>(ns + "odom", 100);
+  io->ground_truth = nh_.advertise<nav_msgs::Odometry>(ns + "base_pose_ground_truth", 100);
+  io->scan = nh_.advertise<sensor_msgs::LaserScan>(ns + "scan", 100);
+  io->joint_states = nh_.advertise<sensor_msgs::JointState>(ns + "joint_states", 100);
+  io->cmd_vel = nh_.subscribe<geometry_msgs::Twist>(
+      ns + "cmd_vel", 1, [this, id](const geometry_msgs::Twist::ConstPtr& msg) { onCmdVel(id, msg); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  io->cmd_pose = nh_.subscribe<geometry_msgs::Pose>(
+      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose::ConstPtr& msg) { onCmdPose(id, msg); });
+
+  // Message parts that never change, filled once.
+  const mbot_description::RobotModel& m = world_->robotModel(id);
+  io->odom_msg.header.frame_id = io->prefix + "odom";
+  io->odom_msg.child_frame_id = io->prefix + "base_footprint";
+  io->ground_truth_msg.header.frame_id = "map";
+  io->ground_truth_msg.child_frame_id = io->prefix + "base_footprint";
+  io->odom_tf.header.frame_id = io->odom_msg.header.frame_id;
+  io->odom_tf.child_frame_id = io->odom_msg.child_frame_id;
+  io->scan_msg.header.frame_id = io->prefix + "base_laser";
+  io->scan_msg.angle_min = m.laser.min_angle;
+  io->scan_msg.angle_increment = m.laser.angleIncrement();
+  io->scan_msg.angle_max = m.laser.min_angle + m.laser.angleIncrement() * (m.laser.beams - 1);
+  io->scan_msg.time_increment = 0.0;
+  io->scan_msg.scan_time = 1.0 / m.laser.rate;
+  io->scan_msg.range_min = m.laser.range_min;
+  io->scan_msg.range_max = m.laser.range_max;
+  for (const auto& joint : m.wheel_joints) io->joint_msg.name.push_back(io->prefix + joint);
+  if (id >= static_cast<int>(io_.size())) io_.resize(id + 1);
+  io_[id] = std::move(io);
+}
+
+// =============================================================================================
+// sensor samples -> messages
+
+void StageRos::onOdometry(int robot, const OdometrySample& s)
+{
+  RobotIo& io = *io_[robot];
+  fillOdometry(io.odom_msg, s.stamp, s.pose, s.twist);
+  io.odom.publish(io.odom_msg);
+  io.odom_tf.header.stamp = io.odom_msg.header.stamp;
+  io.odom_tf.transform.translation.x = s.pose.x;
+  io.odom_tf.transform.translation.y = s.pose.y;
+  io.odom_tf.transform.translation.z = 0.0;
+  io.odom_tf.transform.rotation = io.odom_msg.pose.pose.orientation;
+  tf_batch_.push_back(io.odom_tf);
+}
+
+void StageRos::onGroundTruth(int robot, const GroundTruthSample& s)
+{
+  RobotIo& io = *io_[robot];
+  fillOdometry(io.ground_truth_msg, s.stamp, s.pose, s.twist);
+  io.ground_truth.publish(io.ground_truth_msg);
+}
+
+void StageRos::onJointState(int robot, const JointStateSample& s)
+{
+  RobotIo& io = *io_[robot];
+  io.joint_msg.header.stamp.fromSec(s.stamp);
+  io.joint_msg.position = s.position;
+  io.joint_msg.velocity = s.velocity;
+  io.joint_states.publish(io.joint_msg);
+}
+
+void StageRos::onScan(int robot, const ScanSample& s)
+{
+  RobotIo& io = *io_[robot];
+  io.scan_msg.header.stamp.fromSec(s.stamp);
+  io.scan_msg.ranges.assign(s.ranges.begin(), s.ranges.end());
+  io.scan.publish(io.scan_msg);
+}
+
+void StageRos::onContact(const ContactEvent& e)
+{
+  mbot_msgs::Contact msg;
+  msg.header.stamp.fromSec(e.stamp);
+  msg.header.frame_id = "map";
+  msg.body_a = e.body_a;
+  msg.body_b = e.body_b;
+  msg.position.x = e.x;
+  msg.position.y = e.y;
+  contact_pub_.publish(msg);
+}
+
+// =============================================================================================
+// commands
+
+void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
+{
+  if (!world_->hasRobot(robot)) return;  // removed while the message waited
+  world_->setCommand(robot, Twist2D{msg->linear.x, msg->linear.y, msg->angular.z});
+  io_[robot]->last_cmd_time = world_->time();
+  io_[robot]->cmd_boundary = boundary_count_;
+  io_[robot]->cmd_unused = true;
+}
+
+/// As stage_ros: a geometry_msgs/Pose in the map frame; z, roll and pitch are ignored.
+void StageRos::onCmdPose(int robot, const geometry_msgs::Pose::ConstPtr& msg)
+{
+  if (!world_->hasRobot(robot)) return;
+  const geometry_msgs::Quaternion& q = msg->orientation;
+  const double yaw = mbot_common::yawOf(q.x, q.y, q.z, q.w);
+  if (std::isnan(yaw))
+  {
+    ROS_WARN("stage_node: cmd_pose: %s: the orientation is not a rotation (zero or NaN quaternion)",
+             world_->robotName(robot).c_str());
+    return;
+  }
+  try
+  {
+    world_->teleport(world_->robotName(robot), Pose2D{msg->position.x, msg->position.y, yaw});
+  }
+  catch (const std::exception& e)
+  {
+    ROS_WARN("stage_node: cmd_pose: %s", e.what());
+  }
+}
+
+}  // namespace mbot_sim
