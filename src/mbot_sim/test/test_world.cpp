@@ -243,6 +243,104 @@ TEST(Kinematics, WatchdogStopsARobotWithoutCommands)
   EXPECT_NEAR(world.groundTruth(id).x, x, 1e-9);  // and stays
 }
 
+// ---- true zeros: a stopped robot at rest measures exactly 0 (stage_ros's tests count on it) ----
+
+namespace
+{
+bool exactlyZero(const Twist2D& t) { return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0; }
+}  // namespace
+
+TEST(TrueZeros, AStoppedRobotReportsExactlyZeroTwistInOdometryAndGroundTruth)
+{
+  WorldSettings settings;
+  settings.noise.odom_linear = 0.05;  // noise only while the wheels turn
+  settings.noise.odom_angular = 0.05;
+  World world(roomMap(), settings);
+  Recorder rec;
+  world.setListener(&rec);
+  // against_wall: into the wall block at x = 7.0 at an angle, stopped by the watchdog, resting
+  // against the wall (the contact solver's residue used to leave ~1e-6..1e-14 m/s, and odometry
+  // noise on top while it was above 1e-9); floor: stopped in the open by a zero command;
+  // omni: strafed into the north wall, stopped by a zero command.
+  const int against_wall = world.addRobot("against_wall", diffModel(), Pose2D{6.0, 1.5, 0.0});
+  const int floor = world.addRobot("floor", diffModel(), Pose2D{2.0, 4.0, 0.0});
+  const int omni = world.addRobot("omni", omniModel(), Pose2D{5.0, 6.5, 0.0});
+  for (int i = 0; i < 400; ++i)  // 4 s
+  {
+    if (i % 10 == 0)
+    {
+      world.setCommand(against_wall, Twist2D{0.5, 0.0, 0.3});
+      world.setCommand(floor, Twist2D{0.3, 0.0, 0.5});
+      world.setCommand(omni, Twist2D{0.0, 0.4, 0.0});
+    }
+    world.step();
+  }
+  ASSERT_GE(rec.contactsBetween("against_wall", "map"), 1);
+  ASSERT_GE(rec.contactsBetween("omni", "map"), 1);
+  world.setCommand(floor, Twist2D{});
+  world.setCommand(omni, Twist2D{});
+  run(world, 1.0);  // braking takes at most 0.5 s
+  const double t_rest = world.time();
+  std::map<int, Pose2D> truth_at_rest, odom_at_rest;
+  for (int id : {against_wall, floor, omni})
+  {
+    truth_at_rest[id] = world.groundTruth(id);
+    odom_at_rest[id] = world.odometry(id);
+  }
+  run(world, 2.0);
+  for (int id : {against_wall, floor, omni})
+  {
+    const std::string name = world.robotName(id);
+    int truth_samples = 0, odom_samples = 0;
+    for (const auto& s : rec.truth[id])
+    {
+      if (s.stamp <= t_rest) continue;
+      ++truth_samples;
+      EXPECT_TRUE(exactlyZero(s.twist)) << name << " ground truth at t = " << s.stamp << ": " << s.twist.vx << ", "
+                                        << s.twist.vy << ", " << s.twist.wz;
+      EXPECT_EQ(s.pose.x, truth_at_rest[id].x) << name;
+      EXPECT_EQ(s.pose.y, truth_at_rest[id].y) << name;
+      EXPECT_EQ(s.pose.theta, truth_at_rest[id].theta) << name;
+    }
+    for (const auto& s : rec.odom[id])
+    {
+      if (s.stamp <= t_rest) continue;
+      ++odom_samples;
+      EXPECT_TRUE(exactlyZero(s.twist)) << name << " odometry at t = " << s.stamp << ": " << s.twist.vx << ", "
+                                        << s.twist.vy << ", " << s.twist.wz;
+      EXPECT_EQ(s.pose.x, odom_at_rest[id].x) << name;
+      EXPECT_EQ(s.pose.y, odom_at_rest[id].y) << name;
+      EXPECT_EQ(s.pose.theta, odom_at_rest[id].theta) << name;
+    }
+    EXPECT_EQ(truth_samples, 100) << name;  // 50 Hz for 2 s
+    EXPECT_EQ(odom_samples, 100) << name;
+    for (double v : rec.joints[id].back().velocity) EXPECT_EQ(v, 0.0) << name;
+    EXPECT_TRUE(exactlyZero(world.velocity(id))) << name;
+  }
+}
+
+TEST(TrueZeros, APushedRobotIsNotAtRestAndReportsItsMotion)
+{
+  World world(openMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int pusher = world.addRobot("pusher", diffModel(), Pose2D{0.0, 0.0, 0.0});
+  const int pushed = world.addRobot("pushed", diffModel(), Pose2D{1.0, 0.0, 0.0});  // never commanded
+  drive(world, pusher, Twist2D{0.3, 0.0, 0.0}, 4.0);  // touches after ~2.5 s, then pushes for ~1.5 s
+  const Pose2D moved = world.groundTruth(pushed);
+  EXPECT_GT(moved.x, 1.2);
+  double fastest_truth = 0.0, fastest_odom = 0.0;
+  for (const auto& s : rec.truth[pushed]) fastest_truth = std::max(fastest_truth, s.twist.vx);
+  for (const auto& s : rec.odom[pushed]) fastest_odom = std::max(fastest_odom, s.twist.vx);
+  EXPECT_GT(fastest_truth, 0.1);                   // far above the rest threshold (1e-4 m/s)
+  EXPECT_NEAR(fastest_odom, fastest_truth, 1e-9);  // its wheels turn along (a diff drive senses forward motion)
+  // Once the pusher has stopped (watchdog) both come to rest: exact zeros again.
+  run(world, 1.5);
+  EXPECT_TRUE(exactlyZero(rec.truth[pushed].back().twist));
+  EXPECT_TRUE(exactlyZero(rec.odom[pushed].back().twist));
+  EXPECT_TRUE(exactlyZero(rec.truth[pusher].back().twist));
+}
+
 // ---- contacts ---------------------------------------------------------------------------------
 
 TEST(Contacts, RobotDrivenIntoAWallStopsAtItAndOneContactIsReported)

@@ -64,7 +64,8 @@ public:
 };
 
 /// @brief Odometry: the pose in the robot's odom frame (identity at start and after a reset),
-///        integrated from the measured wheel motion, and the measured velocity in the robot frame.
+///        integrated from the measured wheel motion, and the measured velocity in the robot frame
+///        (exactly zero, without noise, while the robot is at rest; an odom_drift fault still turns).
 struct OdometrySample
 {
   double stamp = 0.0;  ///< sim time of the measurement [s]
@@ -72,7 +73,8 @@ struct OdometrySample
   Twist2D twist;
 };
 
-/// @brief The true pose in the map frame and the true velocity in the robot frame.
+/// @brief The true pose in the map frame and the true velocity in the robot frame (exactly zero
+///        while the robot is at rest: its drive stands still and nothing pushes it).
 struct GroundTruthSample
 {
   double stamp = 0.0;  ///< [s]
@@ -210,7 +212,7 @@ public:
   const std::string& robotName(int robot) const;
   const mbot_description::RobotModel& robotModel(int robot) const;
   Pose2D groundTruth(int robot) const;  ///< true pose in the map frame
-  Twist2D velocity(int robot) const;    ///< true velocity in the robot frame
+  Twist2D velocity(int robot) const;    ///< true velocity in the robot frame (exactly 0 at rest)
   Pose2D odometry(int robot) const;     ///< current odometry pose (odom frame)
   const FaultConfig& faults(int robot) const;
   const NoiseConfig& noise() const;  ///< the sensor noise in force

@@ -105,6 +105,18 @@ void settleRobot(Robot& r)
   const dReal* v = dBodyGetLinearVel(b);
   const dReal* w = dBodyGetAngularVel(b);
   const double vx = v[0], vy = v[1], wz = w[2];
+  const bool drive_stopped = r.setpoint.vx == 0.0 && r.setpoint.vy == 0.0 && r.setpoint.wz == 0.0;
+  if (drive_stopped && std::hypot(vx, vy) < kRestSpeed && std::abs(wz) < kRestSpeed)
+  {
+    // At rest: undo the solver's residue, so that the pose stays and agrees with the zero velocity.
+    const dQuaternion still = {std::cos(r.pose.theta / 2.0), 0.0, 0.0, std::sin(r.pose.theta / 2.0)};
+    dBodySetQuaternion(b, still);
+    dBodySetPosition(b, r.pose.x, r.pose.y, kBodyZ);
+    dBodySetLinearVel(b, 0.0, 0.0, 0.0);
+    dBodySetAngularVel(b, 0.0, 0.0, 0.0);
+    r.velocity = Twist2D{};
+    return;
+  }
   dBodySetLinearVel(b, vx, vy, 0.0);
   dBodySetAngularVel(b, 0.0, 0.0, wz);
 

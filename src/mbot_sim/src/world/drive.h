@@ -32,8 +32,15 @@ void placeBody(Robot& r, const Pose2D& pose);
 /// or with a frozen drive) and becomes the body's velocity.
 void driveRobot(Robot& r, double now, double watchdog_timeout, double dt);
 
+/// [m/s] and [rad/s]: a robot whose drive stands still and that moves slower than this is at
+/// rest. The contact solver leaves a few 1e-6 m/s on a robot resting against a wall; a push by
+/// another robot or a moving obstacle is far faster.
+constexpr double kRestSpeed = 1e-4;
+
 /// After a physics step: back onto the plane (z, roll, pitch), then read the true pose and
-/// velocity into r.pose and r.velocity.
+/// velocity into r.pose and r.velocity. A robot at rest (setpoint zero, slower than kRestSpeed)
+/// stays where it was and its velocity is exactly zero, as stage_ros's robots report ("true
+/// zeros"); a pushed robot moves and reports its motion.
 void settleRobot(Robot& r);
 
 }  // namespace detail
