@@ -12,6 +12,7 @@
  */
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -29,13 +30,59 @@
 
 namespace mbot_common
 {
+/// @brief What checkNoUnknown() does with a key that nobody read.
+enum class UnknownKeys
+{
+  ERROR,  ///< stop the node (the localization nodes, the map server: a typo is never missed)
+  WARN,   ///< warn and go on, as move_base does (the nav node: a drop-in for move_base)
+};
+
+/// @brief Levenshtein distance: single-character insertions, deletions and substitutions.
+inline size_t editDistance(const std::string& a, const std::string& b)
+{
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+  {
+    size_t diagonal = row[0];  // the distance of a[0, i-1) to b[0, j-1)
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j)
+    {
+      const size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
+      diagonal = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitute});
+    }
+  }
+  return row[b.size()];
+}
+
+/// @brief The word of `words` nearest to `word` by edit distance ("" when `words` is empty).
+inline std::string nearestWord(const std::string& word, const std::set<std::string>& words)
+{
+  std::string best;
+  size_t best_distance = 0;
+  for (const std::string& w : words)
+  {
+    const size_t d = editDistance(word, w);
+    if (best.empty() || d < best_distance)
+    {
+      best = w;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
 /// @brief Reads a node's private parameters strictly: a value of the wrong type is an error,
 ///        and checkNoUnknown() reports keys that no get*() call asked for (typos, amcl options
-///        that this node does not have). Errors are std::runtime_error naming the parameter.
+///        that this node does not have), as an error or as warnings (UnknownKeys). Errors are
+///        std::runtime_error naming the parameter.
 class StrictParams
 {
 public:
-  explicit StrictParams(const ros::NodeHandle& private_nh) : nh_(private_nh) {}
+  explicit StrictParams(const ros::NodeHandle& private_nh, UnknownKeys unknown = UnknownKeys::ERROR)
+      : nh_(private_nh), unknown_mode_(unknown)
+  {}
 
   double getDouble(const std::string& key, double default_value)  ///< ints are accepted
   {
@@ -70,21 +117,39 @@ public:
     throw wrongType(key, "a string", v);
   }
 
-  /// @throws std::runtime_error listing every private parameter that was never read
-  void checkNoUnknown() const
+  /**
+   * @brief Report the private parameters that were never read (nor marked known).
+   * @return with UnknownKeys::WARN, one line per such key, naming the nearest known key:
+   *         "unknown parameter /ns/max_vel_xx (ignored; did you mean max_vel_x?)"
+   * @throws std::runtime_error listing them all, with UnknownKeys::ERROR
+   */
+  std::vector<std::string> checkNoUnknown() const
   {
     std::vector<std::string> names;
-    if (!ros::param::getParamNames(names)) return;  // no master: nothing to check against
+    if (!ros::param::getParamNames(names)) return {};  // no master: nothing to check against
     const std::string prefix = nh_.getNamespace() + "/";
-    std::string unknown;
+    std::vector<std::string> unknown_keys;
     for (const std::string& name : names)
     {
       if (name.compare(0, prefix.size(), prefix) != 0) continue;
       const std::string key = name.substr(prefix.size(), name.find('/', prefix.size()) - prefix.size());
-      if (known_.count(key) == 0 && unknown.find(" " + key + ",") == std::string::npos) unknown += " " + key + ",";
+      if (known_.count(key) == 0 && std::find(unknown_keys.begin(), unknown_keys.end(), key) == unknown_keys.end())
+        unknown_keys.push_back(key);
     }
-    if (unknown.empty()) return;
-    std::string known;
+    std::vector<std::string> warnings;
+    if (unknown_keys.empty()) return warnings;
+    if (unknown_mode_ == UnknownKeys::WARN)
+    {
+      for (const std::string& key : unknown_keys)
+      {
+        const std::string nearest = nearestWord(key, known_);
+        warnings.push_back("unknown parameter " + prefix + key + " (ignored" +
+                           (nearest.empty() ? std::string() : "; did you mean " + nearest + "?") + ")");
+      }
+      return warnings;
+    }
+    std::string unknown, known;
+    for (const std::string& k : unknown_keys) unknown += " " + k + ",";
     for (const std::string& k : known_) known += (known.empty() ? "" : ", ") + k;
     unknown.pop_back();
     throw std::runtime_error("unknown parameter(s) under " + nh_.getNamespace() + ":" + unknown +
@@ -123,6 +188,7 @@ private:
   }
 
   ros::NodeHandle nh_;
+  UnknownKeys unknown_mode_;
   std::set<std::string> known_;
 };
 

@@ -99,30 +99,42 @@ void ObstacleLayer::raytrace(double x0, double y0, double x1, double y1, bool ke
   }
 }
 
+double ObstacleLayer::usableRange(double range, const ScanObservation& scan) const
+{
+  const double kSkip = std::numeric_limits<double>::quiet_NaN();
+  if (std::isinf(range) && range > 0.0)
+    // costmap_2d (inf_is_valid) puts the reading a tenth of a millimetre inside range_max.
+    return config_.inf_is_valid ? scan.range_max - 0.0001 : kSkip;
+  if (!std::isfinite(range)) return kSkip;                             // REP-117: invalid, too close
+  if (range < scan.range_min || range > scan.range_max) return kSkip;  // out of the sensor's spec
+  return range;
+}
+
 void ObstacleLayer::updateBounds(const Pose2D& robot, Bounds& bounds)
 {
   // 1. Clearing, for every queued scan (costmap_2d's raytraceFreespace).
   for (const ScanObservation& scan : pending_)
   {
+    if (!config_.clearing) break;
     for (const ScanBeam& beam : scan.beams)
     {
-      const double r = beam.range;
-      if (std::isnan(r) || r == -std::numeric_limits<double>::infinity()) continue;  // REP-117
-      const bool no_return = std::isinf(r);
-      if (!no_return && (r < scan.range_min || r > scan.range_max)) continue;  // out of spec
-      const double length = no_return ? config_.raytrace_range : std::min(r, config_.raytrace_range);
-      const bool hit_inside = !no_return && r <= config_.raytrace_range;
+      const double r = usableRange(beam.range, scan);
+      if (std::isnan(r)) continue;
+      const bool no_end = std::isinf(r);  // +Inf with an infinite range_max: clear, end nowhere
+      const double length = no_end ? config_.raytrace_range : std::min(r, config_.raytrace_range);
+      const bool hit_inside = !no_end && r <= config_.raytrace_range;
       raytrace(scan.origin_x, scan.origin_y, scan.origin_x + length * std::cos(beam.angle),
                scan.origin_y + length * std::sin(beam.angle), hit_inside, bounds);
     }
   }
-  // 2. Marking: finite hits within obstacle_range.
+  // 2. Marking: finite readings within obstacle_range.
   for (const ScanObservation& scan : pending_)
   {
+    if (!config_.marking) break;
     for (const ScanBeam& beam : scan.beams)
     {
-      const double r = beam.range;
-      if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max || r > config_.obstacle_range) continue;
+      const double r = usableRange(beam.range, scan);
+      if (!std::isfinite(r) || r > config_.obstacle_range) continue;
       const double px = scan.origin_x + r * std::cos(beam.angle);
       const double py = scan.origin_y + r * std::sin(beam.angle);
       unsigned mx, my;

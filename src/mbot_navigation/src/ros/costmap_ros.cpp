@@ -27,12 +27,23 @@ std::string stripSlash(std::string frame)
 // costmap_2d keys this node does not implement, by where they appear.
 const std::vector<std::string> kIgnoredCostmapKeys = {"always_send_full_costmap"};
 const std::vector<std::string> kIgnoredStaticKeys = {"first_map_only", "subscribe_to_updates", "use_maximum"};
-const std::vector<std::string> kIgnoredObstacleKeys = {
-    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z", "z_resolution", "z_voxels",
-    "unknown_threshold",   "mark_threshold",      "publish_voxel_map"};
-const std::vector<std::string> kIgnoredSourceKeys = {"sensor_frame",         "observation_persistence",
-                                                     "expected_update_rate", "min_obstacle_height",
-                                                     "max_obstacle_height",  "inf_is_valid"};
+// Obstacle (and voxel) layer keys: this layer is 2-D, fed by one laser, always combined by maximum.
+const std::vector<std::string> kIgnoredObstacleKeys = {"max_obstacle_height",
+                                                       "min_obstacle_height",
+                                                       "combination_method",
+                                                       "transform_tolerance",
+                                                       "origin_z",
+                                                       "z_resolution",
+                                                       "z_voxels",
+                                                       "unknown_threshold",
+                                                       "mark_threshold",
+                                                       "publish_voxel_map"};
+const std::vector<std::string> kIgnoredSourceKeys = {
+    "sensor_frame",        "observation_persistence", "expected_update_rate", "min_obstacle_height",
+    "max_obstacle_height", "obstacle_min_range",      "raytrace_min_range"};
+// Found with searchParam from an observation source upwards (its layer, the costmap, the node).
+const std::vector<std::string> kSearchedRangeKeys = {"obstacle_range", "raytrace_range", "obstacle_max_range",
+                                                     "raytrace_max_range"};
 // Flat layer keys: with `plugins`, costmap_2d reads them from the layers' namespaces instead.
 const std::vector<std::string> kFlatLayerKeys = {"static_map",
                                                  "map_type",
@@ -45,8 +56,6 @@ const std::vector<std::string> kFlatLayerKeys = {"static_map",
                                                  "use_maximum",
                                                  "scan_topic",
                                                  "observation_sources",
-                                                 "obstacle_range",
-                                                 "raytrace_range",
                                                  "footprint_clearing_enabled",
                                                  "max_obstacle_height",
                                                  "min_obstacle_height",
@@ -82,24 +91,34 @@ const std::vector<std::string> kFlatLayerKeys = {"static_map",
                                                  "moving_obstacles_blocked_time"};
 
 /// The static layer's keys of `p` (the costmap's namespace, or the layer's).
-void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
+void readStaticLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamReport& r)
 {
   s.map_topic = p.getString("map_topic", s.map_topic);
   s.static_layer.lethal_cost_threshold = p.getInt("lethal_cost_threshold", s.static_layer.lethal_cost_threshold);
   s.static_layer.unknown_cost_value = p.getInt("unknown_cost_value", s.static_layer.unknown_cost_value);
   s.static_layer.trinary_costmap = p.getBool("trinary_costmap", s.static_layer.trinary_costmap);
-  ignoreStandardKeys(p, nh, kIgnoredStaticKeys, "a costmap_2d static layer key", w);
+  ignoreStandardKeys(p, nh, kIgnoredStaticKeys, "a costmap_2d static layer key", r);
+}
+
+/// A source's range, found as costmap_2d finds it: noetic's `<name>_max_range`, else the older
+/// `<name>_range`, each with searchParam from the source's namespace upwards.
+double searchRange(const ros::NodeHandle& source_nh, const std::string& name, double default_value)
+{
+  std::string found;
+  const double value = searchDouble(source_nh, name + "_max_range", default_value, &found);
+  return found.empty() ? searchDouble(source_nh, name + "_range", default_value) : value;
 }
 
 /// The obstacle layer's keys: ours (scan_topic) or costmap_2d's observation_sources, of which one
-/// LaserScan source is used (its own obstacle_range / raytrace_range win, as in costmap_2d).
-void readObstacleLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamWarnings& w)
+/// LaserScan source is used. The ranges are searched from the source upwards, as in costmap_2d.
+void readObstacleLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, ParamReport& r)
 {
   ObstacleLayerConfig& o = s.obstacle_layer;
-  o.obstacle_range = p.getDouble("obstacle_range", o.obstacle_range);
-  o.raytrace_range = p.getDouble("raytrace_range", o.raytrace_range);
+  for (const std::string& key : kSearchedRangeKeys) p.markKnown(key);
+  o.obstacle_range = searchRange(nh, "obstacle", o.obstacle_range);
+  o.raytrace_range = searchRange(nh, "raytrace", o.raytrace_range);
   o.footprint_clearing_enabled = p.getBool("footprint_clearing_enabled", o.footprint_clearing_enabled);
-  ignoreStandardKeys(p, nh, kIgnoredObstacleKeys, "a costmap_2d obstacle layer key", w);
+  ignoreStandardKeys(p, nh, kIgnoredObstacleKeys, "a costmap_2d obstacle layer key", r);
   const bool has_scan_topic = nh.hasParam("scan_topic");
   s.scan_topic = p.getString("scan_topic", s.scan_topic);
   if (!nh.hasParam("observation_sources")) return;
@@ -111,36 +130,36 @@ void readObstacleLayer(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSet
   std::string name;
   while (names >> name)
   {
-    StrictParams sp{ros::NodeHandle(nh, name)};
     const ros::NodeHandle source_nh(nh, name);
+    StrictParams sp{source_nh, mbot_common::UnknownKeys::WARN};
     p.markKnown(name);
+    // costmap_2d's defaults; a source without `topic` subscribes to its own name.
     const std::string data_type = sp.getString("data_type", "PointCloud");
     const std::string topic = sp.getString("topic", name);
     const bool marking = sp.getBool("marking", true), clearing = sp.getBool("clearing", false);
-    const double obstacle_range = sp.getDouble("obstacle_range", o.obstacle_range);
-    const double raytrace_range = sp.getDouble("raytrace_range", o.raytrace_range);
-    ignoreStandardKeys(sp, source_nh, kIgnoredSourceKeys, "a costmap_2d observation source key", w);
-    sp.checkNoUnknown();
+    const bool inf_is_valid = sp.getBool("inf_is_valid", false);
+    for (const std::string& key : kSearchedRangeKeys) sp.markKnown(key);
+    const double obstacle_range = searchRange(source_nh, "obstacle", o.obstacle_range);
+    const double raytrace_range = searchRange(source_nh, "raytrace", o.raytrace_range);
+    ignoreStandardKeys(sp, source_nh, kIgnoredSourceKeys, "a costmap_2d observation source key", r);
+    reportUnknownKeys(sp, r);
     if (data_type != "LaserScan" && data_type != "PointCloud" && data_type != "PointCloud2")
       throw std::runtime_error("parameter " + source_nh.resolveName("data_type") +
                                ": expected LaserScan, PointCloud or PointCloud2, got '" + data_type + "'");
     if (data_type != "LaserScan")
-      w.push_back("observation source " + source_nh.getNamespace() + ": data_type " + data_type +
-                  " is not implemented (LaserScan only); ignored");
+      r.notes.push_back("observation source " + source_nh.getNamespace() + ": data_type " + data_type +
+                        " is not implemented (LaserScan only); ignored");
     else if (!s.scan_topic.empty())
-      w.push_back("observation source " + source_nh.getNamespace() + ": only one LaserScan source is implemented (" +
-                  s.scan_topic + " is used); ignored");
-    else if (!marking && !clearing)
-      w.push_back("observation source " + source_nh.getNamespace() + ": neither marking nor clearing; ignored");
+      r.notes.push_back("observation source " + source_nh.getNamespace() +
+                        ": only one LaserScan source is implemented (" + s.scan_topic + " is used); ignored");
     else
     {
-      if (!marking || !clearing)
-        w.push_back("observation source " + source_nh.getNamespace() +
-                    ": marking and clearing are always both done here; '" + (marking ? "clearing" : "marking") +
-                    ": false' is ignored");
       s.scan_topic = topic;
       o.obstacle_range = obstacle_range;
       o.raytrace_range = raytrace_range;
+      o.marking = marking;
+      o.clearing = clearing;
+      o.inf_is_valid = inf_is_valid;
     }
   }
 }
@@ -197,7 +216,7 @@ void readMovingLayer(StrictParams& p, const std::string& prefix, const std::stri
 
 /// costmap_2d's `plugins` list: [{name, type}, ...] -> the layers, each read from its namespace.
 void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings& s, int& prediction_cost,
-                 ParamWarnings& w)
+                 ParamReport& r)
 {
   XmlRpc::XmlRpcValue list;
   nh.getParam("plugins", list);
@@ -237,7 +256,7 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
                                "): this node has one layer of each kind");
     seen.push_back(it->second);
     const ros::NodeHandle layer_nh(nh, name);
-    StrictParams lp(layer_nh);
+    StrictParams lp(layer_nh, mbot_common::UnknownKeys::WARN);
     p.markKnown(name);
     const bool enabled = lp.getBool("enabled", true);
     switch (it->second)
@@ -245,16 +264,17 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
       case LayerKind::STATIC:
         s.static_map = enabled;
         s.static_layer.track_unknown_space = lp.getBool("track_unknown_space", s.costmap.track_unknown_space);
-        readStaticLayer(lp, layer_nh, s, w);
+        readStaticLayer(lp, layer_nh, s, r);
         break;
       case LayerKind::OBSTACLE:
         if (type == "costmap_2d::VoxelLayer")
-          w.push_back("layer " + layer_nh.getNamespace() + ": costmap_2d::VoxelLayer is read as a 2-D obstacle layer");
+          r.notes.push_back("layer " + layer_nh.getNamespace() +
+                            ": costmap_2d::VoxelLayer is read as a 2-D obstacle layer");
         s.obstacle_layer.track_unknown_space = lp.getBool("track_unknown_space", s.costmap.track_unknown_space);
         if (!layer_nh.hasParam("scan_topic") && !layer_nh.hasParam("observation_sources"))
           throw std::runtime_error("layer " + layer_nh.getNamespace() + " (" + type +
                                    "): expected observation_sources (or scan_topic)");
-        readObstacleLayer(lp, layer_nh, s, w);
+        readObstacleLayer(lp, layer_nh, s, r);
         if (!enabled) s.scan_topic.clear();
         break;
       case LayerKind::INFLATION:
@@ -271,7 +291,7 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
         readMovingLayer(lp, "", layer_nh.getNamespace() + "/", s);
         break;
     }
-    lp.checkNoUnknown();
+    reportUnknownKeys(lp, r);
   }
   s.layer_order = seen;  // built in the listed order
   if (s.moving_obstacles && s.scan_topic.empty())
@@ -279,30 +299,30 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
                              ": mbot_navigation::MovingObstaclesLayer tracks what the obstacle layer's LaserScan "
                              "source sees; list an enabled costmap_2d::ObstacleLayer with one");
   if (!s.inflation)
-    w.push_back("parameter " + param + ": no inflation layer, so nothing keeps the robot's radius off obstacles");
+    r.notes.push_back("parameter " + param + ": no inflation layer, so nothing keeps the robot's radius off obstacles");
   for (const std::string& key : kFlatLayerKeys)
     if (nh.hasParam(key))
     {
       p.markKnown(key);
-      w.push_back("parameter " + nh.resolveName(key) +
-                  ": with `plugins`, layer settings go in the layer's namespace; ignored");
+      r.notes.push_back("parameter " + nh.resolveName(key) +
+                        ": with `plugins`, layer settings go in the layer's namespace; ignored");
     }
 }
 }  // namespace
 
 CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& d,
-                                       std::vector<std::string>* warnings)
+                                       ParamReport* report)
 {
-  ParamWarnings local_warnings;
-  ParamWarnings& w = warnings ? *warnings : local_warnings;
-  StrictParams p(costmap_nh);
+  ParamReport local_report;
+  ParamReport& r = report ? *report : local_report;
+  StrictParams p(costmap_nh, mbot_common::UnknownKeys::WARN);
   CostmapRosSettings s = d;
   s.global_frame = stripSlash(p.getString("global_frame", d.global_frame));
   s.robot_base_frame = stripSlash(p.getString("robot_base_frame", d.robot_base_frame));
   s.update_frequency = p.getDouble("update_frequency", d.update_frequency);
   s.publish_frequency = p.getDouble("publish_frequency", d.publish_frequency);
   s.transform_tolerance = p.getDouble("transform_tolerance", d.transform_tolerance);
-  ignoreStandardKeys(p, costmap_nh, kIgnoredCostmapKeys, "a costmap_2d key", w);
+  ignoreStandardKeys(p, costmap_nh, kIgnoredCostmapKeys, "a costmap_2d key", r);
 
   LayeredCostmapConfig& c = s.costmap;
   c.rolling_window = p.getBool("rolling_window", d.costmap.rolling_window);
@@ -311,16 +331,24 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
   c.resolution = p.getDouble("resolution", d.costmap.resolution);
   c.origin_x = p.getDouble("origin_x", d.costmap.origin_x);
   c.origin_y = p.getDouble("origin_y", d.costmap.origin_y);
-  c.robot_radius = p.getDouble("robot_radius", d.costmap.robot_radius);
-  XmlRpc::XmlRpcValue footprint;
+  // As costmap_2d: `footprint`, else `robot_radius`, searched from here upwards (so both may stand
+  // at the node's level, for both costmaps). A footprint "[]" counts as none.
   p.markKnown("footprint");
-  if (costmap_nh.getParam("footprint", footprint))
+  p.markKnown("robot_radius");
+  for (const std::string& key : kSearchedRangeKeys) p.markKnown(key);  // the sources search them up to here
+  std::string footprint_name, radius_name;
+  XmlRpc::XmlRpcValue footprint;
+  if (costmap_nh.searchParam("footprint", footprint_name) && costmap_nh.getParam(footprint_name, footprint) &&
+      !(footprint.getType() == XmlRpc::XmlRpcValue::TypeString &&
+        (static_cast<std::string>(footprint).empty() || static_cast<std::string>(footprint) == "[]")))
   {
-    // As costmap_2d: a footprint wins over robot_radius. The layers here are circular.
-    c.robot_radius = footprintRadius(footprint, costmap_nh.resolveName("footprint"));
-    w.push_back("parameter " + costmap_nh.resolveName("footprint") + ": the footprint polygon is taken as its " +
-                "circumscribed circle, radius " + std::to_string(c.robot_radius) + " m");
+    // The layers here are circular.
+    c.robot_radius = footprintRadius(footprint, footprint_name);
+    r.notes.push_back("parameter " + footprint_name + ": the footprint polygon is taken as its " +
+                      "circumscribed circle, radius " + std::to_string(c.robot_radius) + " m");
   }
+  else
+    c.robot_radius = searchDouble(costmap_nh, "robot_radius", d.costmap.robot_radius);
   c.robot_radius += p.getDouble("footprint_padding", 0.0);
   c.track_unknown_space = p.getBool("track_unknown_space", d.costmap.track_unknown_space);
   s.static_layer.track_unknown_space = c.track_unknown_space;
@@ -328,22 +356,22 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
 
   int prediction_cost = d.robots.prediction_cost;
   if (costmap_nh.hasParam("plugins"))
-    readPlugins(p, costmap_nh, s, prediction_cost, w);
+    readPlugins(p, costmap_nh, s, prediction_cost, r);
   else
   {
     // costmap_2d's pre-layer form: static_map picks the static layer, map_type the obstacle layer.
     s.static_map = p.getBool("static_map", d.static_map);
     const std::string map_type = p.getString("map_type", "costmap");
     if (map_type == "voxel")
-      w.push_back("parameter " + costmap_nh.resolveName("map_type") + ": voxel is read as a 2-D obstacle layer");
+      r.notes.push_back("parameter " + costmap_nh.resolveName("map_type") + ": voxel is read as a 2-D obstacle layer");
     else if (map_type != "costmap")
       throw std::runtime_error("parameter " + costmap_nh.resolveName("map_type") +
                                ": expected costmap or voxel, got '" + map_type + "'");
-    readStaticLayer(p, costmap_nh, s, w);
-    readObstacleLayer(p, costmap_nh, s, w);
+    readStaticLayer(p, costmap_nh, s, r);
+    readObstacleLayer(p, costmap_nh, s, r);
     readInflationLayer(p, s);
     // Written by the inflation layer's dynamic_reconfigure server; the flat keys win.
-    StrictParams ip{ros::NodeHandle(costmap_nh, s.inflation_layer_name)};
+    StrictParams ip{ros::NodeHandle(costmap_nh, s.inflation_layer_name), mbot_common::UnknownKeys::WARN};
     p.markKnown(s.inflation_layer_name);
     const InflationLayerConfig flat = s.inflation_layer;
     readInflationLayer(ip, s);
@@ -354,13 +382,13 @@ CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const 
         if (std::string(key) == "cost_scaling_factor") s.inflation_layer.cost_scaling_factor = flat.cost_scaling_factor;
         if (std::string(key) == "inflate_unknown") s.inflation_layer.inflate_unknown = flat.inflate_unknown;
       }
-    ip.checkNoUnknown();
+    reportUnknownKeys(ip, r);
     s.robots_layer = p.getBool("robots_layer", d.robots_layer);
     readRobotsLayer(p, "robots_", s, prediction_cost);
     s.moving_obstacles = p.getBool("moving_obstacles_layer", d.moving_obstacles);
     readMovingLayer(p, "moving_obstacles_", costmap_nh.getNamespace() + "/", s);
   }
-  p.checkNoUnknown();
+  reportUnknownKeys(p, r);
   s.moving.obstacle_range = s.obstacle_layer.obstacle_range;  // it tracks what the obstacle layer marks
 
   const std::string ns = costmap_nh.getNamespace() + "/";

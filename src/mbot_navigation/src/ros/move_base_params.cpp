@@ -16,20 +16,71 @@ namespace
 {
 // Standard keys this node does not implement (docs/move_base_keys.md), by namespace.
 const std::vector<std::string> kIgnoredMoveBaseKeys = {
-    "recovery_behaviors",      "conservative_reset_dist",        "shutdown_costmaps", "max_planning_retries",
-    "make_plan_clear_costmap", "make_plan_add_unreachable_goal", "restore_defaults",  "conservative_reset",
-    "aggressive_reset",        "TrajectoryPlannerROS",           "CarrotPlanner"};
-const std::vector<std::string> kIgnoredGlobalPlannerKeys = {"default_tolerance", "visualize_potential",
-                                                            "use_dijkstra",      "use_quadratic",
-                                                            "use_grid_path",     "old_navfn_behavior",
-                                                            "lethal_cost",       "publish_potential",
-                                                            "orientation_mode",  "orientation_window_size",
-                                                            "outline_map",       "planner_window_x",
-                                                            "planner_window_y",  "planner_costmap_publish_frequency",
-                                                            "restore_defaults"};
-const std::vector<std::string> kIgnoredDwaKeys = {
-    "acc_lim_trans",   "acc_limit_trans",      "stop_time_buffer", "scaling_speed", "max_scaling_factor", "use_dwa",
-    "publish_traj_pc", "publish_cost_grid_pc", "global_frame_id",  "meter_scoring", "restore_defaults"};
+    "recovery_behaviors", "conservative_reset_dist", "shutdown_costmaps", "max_planning_retries",
+    "make_plan_clear_costmap", "make_plan_add_unreachable_goal", "restore_defaults",
+    // the namespaces of move_base's default recoveries, and of a planner this node does not have
+    "conservative_reset", "rotate_recovery", "aggressive_reset", "CarrotPlanner"};
+const std::vector<std::string> kIgnoredNavfnKeys = {"default_tolerance", "visualize_potential", "planner_window_x",
+                                                    "planner_window_y", "planner_costmap_publish_frequency"};
+const std::vector<std::string> kIgnoredGlobalPlannerKeys = {
+    "default_tolerance",       "visualize_potential", "use_dijkstra",      "use_quadratic",    "use_grid_path",
+    "old_navfn_behavior",      "lethal_cost",         "publish_potential", "publish_scale",    "orientation_mode",
+    "orientation_window_size", "outline_map",         "planner_window_x",  "planner_window_y", "restore_defaults"};
+const std::vector<std::string> kIgnoredDwaKeys = {"acc_lim_trans",   "acc_limit_trans",      "stop_time_buffer",
+                                                  "scaling_speed",   "max_scaling_factor",   "use_dwa",
+                                                  "sum_scores",      "cheat_factor",         "sim_period",
+                                                  "publish_traj_pc", "publish_cost_grid_pc", "publish_cost_grid",
+                                                  "global_frame_id", "meter_scoring",        "restore_defaults"};
+// base_local_planner's TrajectoryPlannerROS: accepted so that a set with both local planners loads;
+// this node runs DWA (base_local_planner/TrajectoryPlannerROS as base_local_planner is an error).
+const std::vector<std::string> kTrajectoryPlannerKeys = {"acc_lim_x",
+                                                         "acc_lim_y",
+                                                         "acc_lim_theta",
+                                                         "acc_lim_th",
+                                                         "max_vel_x",
+                                                         "min_vel_x",
+                                                         "max_vel_theta",
+                                                         "min_vel_theta",
+                                                         "max_rotational_vel",
+                                                         "min_in_place_vel_theta",
+                                                         "min_in_place_rotational_vel",
+                                                         "escape_vel",
+                                                         "backup_vel",
+                                                         "holonomic_robot",
+                                                         "y_vels",
+                                                         "yaw_goal_tolerance",
+                                                         "xy_goal_tolerance",
+                                                         "latch_xy_goal_tolerance",
+                                                         "sim_time",
+                                                         "sim_granularity",
+                                                         "angular_sim_granularity",
+                                                         "vx_samples",
+                                                         "vtheta_samples",
+                                                         "controller_frequency",
+                                                         "meter_scoring",
+                                                         "path_distance_bias",
+                                                         "goal_distance_bias",
+                                                         "pdist_scale",
+                                                         "gdist_scale",
+                                                         "occdist_scale",
+                                                         "heading_lookahead",
+                                                         "heading_scoring",
+                                                         "heading_scoring_timestep",
+                                                         "dwa",
+                                                         "simple_attractor",
+                                                         "publish_cost_grid_pc",
+                                                         "global_frame_id",
+                                                         "oscillation_reset_dist",
+                                                         "escape_reset_dist",
+                                                         "escape_reset_theta",
+                                                         "prune_plan",
+                                                         "stop_time_buffer",
+                                                         "world_model",
+                                                         "point_grid",
+                                                         "restore_defaults"};
+// costmap_2d finds these with searchParam, so they may stand at the node's level (for both costmaps).
+const std::vector<std::string> kSearchedCostmapKeys = {"footprint",      "robot_radius",       "obstacle_range",
+                                                       "raytrace_range", "obstacle_max_range", "raytrace_max_range"};
 
 /// DWA keys may be given flat (~max_vel_x) or under ~DWAPlannerROS/ (dwa_local_planner's place).
 /// Where both are set they must agree (dynamic_reconfigure writes ~DWAPlannerROS/ at start-up,
@@ -45,8 +96,25 @@ public:
     if (!old_name.empty()) d = get(old_name, d, &StrictParams::getDouble);
     return get(key, d, &StrictParams::getDouble);
   }
-  int getInt(const std::string& key, int d) { return get(key, d, &StrictParams::getInt); }
+  int getInt(const std::string& key, int d, const std::string& old_name = "")
+  {
+    if (!old_name.empty()) d = get(old_name, d, &StrictParams::getInt);
+    return get(key, d, &StrictParams::getInt);
+  }
   bool getBool(const std::string& key, bool d) { return get(key, d, &StrictParams::getBool); }
+  std::string getString(const std::string& key, const std::string& d)
+  {
+    const std::string flat = flat_.getString(key, d);
+    const std::string scoped = scoped_.getString(key, flat);
+    if (nh_.hasParam(key) && nh_.hasParam("DWAPlannerROS/" + key) && flat != scoped) throw conflict(key);
+    return scoped;
+  }
+  /// True when `key` is set flat or under DWAPlannerROS/.
+  bool has(const std::string& key) const { return nh_.hasParam(key) || nh_.hasParam("DWAPlannerROS/" + key); }
+  std::string name(const std::string& key) const
+  {
+    return nh_.resolveName(nh_.hasParam("DWAPlannerROS/" + key) ? "DWAPlannerROS/" + key : key);
+  }
 
 private:
   template <typename T>
@@ -54,10 +122,13 @@ private:
   {
     const T flat = (flat_.*read)(key, d);
     const T scoped = (scoped_.*read)(key, flat);
-    if (nh_.hasParam(key) && nh_.hasParam("DWAPlannerROS/" + key) && flat != scoped)
-      throw std::runtime_error("parameter " + nh_.resolveName(key) + " is also set, to another value, as " +
-                               nh_.resolveName("DWAPlannerROS/" + key) + ": set it in one place");
+    if (nh_.hasParam(key) && nh_.hasParam("DWAPlannerROS/" + key) && flat != scoped) throw conflict(key);
     return scoped;
+  }
+  std::runtime_error conflict(const std::string& key) const
+  {
+    return std::runtime_error("parameter " + nh_.resolveName(key) + " is also set, to another value, as " +
+                              nh_.resolveName("DWAPlannerROS/" + key) + ": set it in one place");
   }
   ros::NodeHandle nh_;
   StrictParams& flat_;
@@ -66,8 +137,15 @@ private:
 
 /// The DWA settings: dwa_local_planner's defaults, the robot model's limits, then the parameters.
 DwaConfig readDwaConfig(DwaParams& p, const mbot_description::RobotModel& model, double footprint_radius,
-                        double controller_frequency)
+                        double controller_frequency, ParamReport& report)
 {
+  // Names that dwa_local_planner itself does not read, but its wiki page (acc_lim_th) and
+  // base_local_planner (vtheta_samples) use: read as the current names.
+  for (const auto& alias :
+       {std::make_pair("acc_lim_th", "acc_lim_theta"), std::make_pair("vtheta_samples", "vth_samples")})
+    if (p.has(alias.first))
+      report.notes.push_back("parameter " + p.name(alias.first) + ": read as " + alias.second +
+                             " (dwa_local_planner reads only " + alias.second + ")");
   DwaConfig c;
   applyModelLimits(model.limits, c);
 
@@ -92,7 +170,18 @@ DwaConfig readDwaConfig(DwaParams& p, const mbot_description::RobotModel& model,
   c.angular_sim_granularity = p.getDouble("angular_sim_granularity", c.angular_sim_granularity);
   c.vx_samples = p.getInt("vx_samples", c.vx_samples);
   c.vy_samples = p.getInt("vy_samples", c.vy_samples);
-  c.vth_samples = p.getInt("vth_samples", c.vth_samples);
+  c.vth_samples = p.getInt("vth_samples", c.vth_samples, "vtheta_samples");
+  // dwa_local_planner's dynamic_reconfigure server raises a count below 1 to 1 (vy_samples: 0 is common).
+  for (int* samples : {&c.vx_samples, &c.vy_samples, &c.vth_samples})
+    if (*samples < 1)
+    {
+      const char* key = samples == &c.vx_samples   ? "vx_samples"
+                        : samples == &c.vy_samples ? "vy_samples"
+                                                   : "vth_samples";
+      report.notes.push_back("parameter " + p.name(key) + ": " + std::to_string(*samples) +
+                             " is raised to 1, as dwa_local_planner does");
+      *samples = 1;
+    }
   c.path_distance_bias = p.getDouble("path_distance_bias", c.path_distance_bias);
   c.goal_distance_bias = p.getDouble("goal_distance_bias", c.goal_distance_bias);
   c.occdist_scale = p.getDouble("occdist_scale", c.occdist_scale);
@@ -162,18 +251,58 @@ double toNumber(const XmlRpc::XmlRpcValue& v, bool& ok)
   ok = false;
   return 0.0;
 }
+/// move_base's recovery_behaviors name the namespaces of their settings: accept those (the
+/// recoveries here are fixed: clear costmaps, rotate, back up).
+void ignoreRecoveryNamespaces(StrictParams& p, const ros::NodeHandle& nh, ParamReport& report)
+{
+  XmlRpc::XmlRpcValue list;
+  if (!nh.getParam("recovery_behaviors", list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray) return;
+  for (int i = 0; i < list.size(); ++i)
+  {
+    XmlRpc::XmlRpcValue& entry = list[i];
+    if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct || !entry.hasMember("name") ||
+        entry["name"].getType() != XmlRpc::XmlRpcValue::TypeString)
+      continue;
+    const std::string name = entry["name"];
+    p.markKnown(name);
+    if (nh.hasParam(name))
+      report.notes.push_back("parameter " + nh.resolveName(name) + ": the settings of recovery behaviour '" + name +
+                             "', which this node does not run; ignored");
+  }
+}
 }  // namespace
 
 void ignoreStandardKeys(StrictParams& p, const ros::NodeHandle& nh, const std::vector<std::string>& keys,
-                        const std::string& what, ParamWarnings& warnings)
+                        const std::string& what, ParamReport& report)
 {
   for (const std::string& key : keys)
   {
-    if (!nh.hasParam(key)) continue;
     p.markKnown(key);
-    warnings.push_back("parameter " + nh.resolveName(key) + ": " + what +
-                       " that this node does not implement; ignored");
+    if (!nh.hasParam(key)) continue;
+    const std::string note = "parameter " + nh.resolveName(key) + ": ";
+    const bool noted = std::any_of(report.notes.begin(), report.notes.end(),
+                                   [&](const std::string& n) { return n.compare(0, note.size(), note) == 0; });
+    if (!noted) report.notes.push_back(note + what + " that this node does not implement; ignored");
   }
+}
+
+void reportUnknownKeys(const StrictParams& p, ParamReport& report)
+{
+  for (const std::string& w : p.checkNoUnknown()) report.warnings.push_back(w);
+}
+
+double searchDouble(const ros::NodeHandle& from, const std::string& key, double default_value, std::string* found)
+{
+  std::string name;
+  if (found) found->clear();
+  if (!from.searchParam(key, name)) return default_value;
+  XmlRpc::XmlRpcValue v;
+  if (!from.getParam(name, v)) return default_value;
+  bool ok = true;
+  const double value = toNumber(v, ok);
+  if (!ok) throw std::runtime_error("parameter " + name + ": expected a number");
+  if (found) *found = name;
+  return value;
 }
 
 std::string globalPlannerFor(const std::string& name, const std::string& param)
@@ -232,10 +361,10 @@ double footprintRadius(const XmlRpc::XmlRpcValue& footprint, const std::string& 
 }
 
 NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
-                        const std::string& description_dir, ParamWarnings& warnings)
+                        const std::string& description_dir, ParamReport& report)
 {
   NavParams out;
-  StrictParams p(private_nh);
+  StrictParams p(private_nh, mbot_common::UnknownKeys::WARN);
   out.robot = mbot_common::robotName(p, nh);
   out.model = p.getString("model", "mbot");
   mbot_description::RobotModel model;
@@ -268,7 +397,9 @@ NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& privat
   out.back_up.speed = p.getDouble("back_up_speed", out.back_up.speed);
   require(out.back_up.distance >= 0.0, private_nh, "back_up_distance", "a number >= 0 [m] (0: no backing up)");
   require(out.back_up.speed > 0.0, private_nh, "back_up_speed", "a number > 0 [m/s]");
-  ignoreStandardKeys(p, private_nh, kIgnoredMoveBaseKeys, "a move_base key", warnings);
+  ignoreStandardKeys(p, private_nh, kIgnoredMoveBaseKeys, "a move_base key", report);
+  ignoreRecoveryNamespaces(p, private_nh, report);
+  for (const std::string& key : kSearchedCostmapKeys) p.markKnown(key);  // read by the costmaps (searchParam)
 
   // --- teammates
   out.robots = readNameList(private_nh, "robots");
@@ -292,8 +423,8 @@ NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& privat
   local_defaults.publish_frequency = 2.0;
   p.markKnown("global_costmap");
   p.markKnown("local_costmap");
-  out.global_costmap = readCostmapSettings(ros::NodeHandle(private_nh, "global_costmap"), global_defaults, &warnings);
-  out.local_costmap = readCostmapSettings(ros::NodeHandle(private_nh, "local_costmap"), local_defaults, &warnings);
+  out.global_costmap = readCostmapSettings(ros::NodeHandle(private_nh, "global_costmap"), global_defaults, &report);
+  out.local_costmap = readCostmapSettings(ros::NodeHandle(private_nh, "local_costmap"), local_defaults, &report);
   if (out.global_costmap.robot_base_frame != out.local_costmap.robot_base_frame)
     throw std::runtime_error("parameters " + private_nh.resolveName("global_costmap/robot_base_frame") + " and " +
                              private_nh.resolveName("local_costmap/robot_base_frame") +
@@ -302,53 +433,69 @@ NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& privat
   {
     // move_base's tutorials run the local costmap in odom. Here the plan is shared between the
     // two costmaps, so the local window lives in the global costmap's frame.
-    warnings.push_back("parameter " + private_nh.resolveName("local_costmap/global_frame") + ": '" +
-                       out.local_costmap.global_frame + "' is not the global costmap's frame; the local costmap " +
-                       "runs in '" + out.global_costmap.global_frame + "' here (the plan is shared)");
+    report.notes.push_back("parameter " + private_nh.resolveName("local_costmap/global_frame") + ": '" +
+                           out.local_costmap.global_frame + "' is not the global costmap's frame; the local costmap " +
+                           "runs in '" + out.global_costmap.global_frame + "' here (the plan is shared)");
     out.local_costmap.global_frame = out.global_costmap.global_frame;
   }
 
   // --- planners: our A* reads global_planner's keys (and navfn's allow_unknown when it stands in for navfn)
   {
     const ros::NodeHandle gp_nh(private_nh, "GlobalPlanner");
-    StrictParams gp(gp_nh);
+    StrictParams gp(gp_nh, mbot_common::UnknownKeys::WARN);
     p.markKnown("GlobalPlanner");
     out.planners.astar = readAStarConfig(gp);
-    ignoreStandardKeys(gp, gp_nh, kIgnoredGlobalPlannerKeys, "a global_planner key", warnings);
-    gp.checkNoUnknown();
+    ignoreStandardKeys(gp, gp_nh, kIgnoredGlobalPlannerKeys, "a global_planner key", report);
+    reportUnknownKeys(gp, report);
     const ros::NodeHandle nf_nh(private_nh, "NavfnROS");
-    StrictParams nf(nf_nh);
+    StrictParams nf(nf_nh, mbot_common::UnknownKeys::WARN);
     p.markKnown("NavfnROS");
     const bool navfn_allow_unknown = nf.getBool("allow_unknown", out.planners.astar.allow_unknown);
     if (global_planner == "navfn/NavfnROS") out.planners.astar.allow_unknown = navfn_allow_unknown;
-    ignoreStandardKeys(nf, nf_nh, kIgnoredGlobalPlannerKeys, "a navfn key", warnings);
-    nf.checkNoUnknown();
-    StrictParams op(ros::NodeHandle(private_nh, "OmplPlanner"));
+    ignoreStandardKeys(nf, nf_nh, kIgnoredNavfnKeys, "a navfn key", report);
+    reportUnknownKeys(nf, report);
+    StrictParams op(ros::NodeHandle(private_nh, "OmplPlanner"), mbot_common::UnknownKeys::WARN);
     p.markKnown("OmplPlanner");
     out.planners.ompl = readOmplConfig(op);
-    op.checkNoUnknown();
+    reportUnknownKeys(op, report);
   }
   nav.allow_unknown = out.planners.astar.allow_unknown;
   {
     const ros::NodeHandle dwa_nh(private_nh, "DWAPlannerROS");
-    StrictParams dp(dwa_nh);
+    StrictParams dp(dwa_nh, mbot_common::UnknownKeys::WARN);
     p.markKnown("DWAPlannerROS");
     DwaParams dwa_params(private_nh, p, dp);
+    // As dwa_local_planner: its own controller_frequency (searchParam), else move_base's.
+    const double dwa_frequency = dp.getDouble("controller_frequency", out.controller_frequency);
     try
     {
-      out.dwa = readDwaConfig(dwa_params, model, out.local_costmap.costmap.robot_radius, out.controller_frequency);
+      out.dwa = readDwaConfig(dwa_params, model, out.local_costmap.costmap.robot_radius, dwa_frequency, report);
     }
     catch (const std::invalid_argument& e)
     {
       throw std::runtime_error(std::string("parameters ") + dwa_nh.getNamespace() + "/: " + e.what());
     }
-    std::vector<std::string> scoped_ignored = kIgnoredDwaKeys;
-    scoped_ignored.push_back("controller_frequency");  // dwa_local_planner's own rate; move_base's is used
-    ignoreStandardKeys(dp, dwa_nh, scoped_ignored, "a dwa_local_planner key", warnings);
-    ignoreStandardKeys(p, private_nh, kIgnoredDwaKeys, "a dwa_local_planner key", warnings);
-    dp.checkNoUnknown();
+    out.odom_topic = dwa_params.getString("odom_topic", out.odom_topic);
+    ignoreStandardKeys(dp, dwa_nh, kIgnoredDwaKeys, "a dwa_local_planner key", report);
+    ignoreStandardKeys(p, private_nh, kIgnoredDwaKeys, "a dwa_local_planner key", report);
+    reportUnknownKeys(dp, report);
   }
-  p.checkNoUnknown();
+  {
+    const ros::NodeHandle tp_nh(private_nh, "TrajectoryPlannerROS");
+    StrictParams tp(tp_nh, mbot_common::UnknownKeys::WARN);
+    p.markKnown("TrajectoryPlannerROS");
+    ignoreStandardKeys(tp, tp_nh, kTrajectoryPlannerKeys, "a base_local_planner key (this node runs DWA)", report);
+    reportUnknownKeys(tp, report);
+  }
+  reportUnknownKeys(p, report);
+  // Both costmaps may find the same key at the node's level (footprint): say it once.
+  for (std::vector<std::string>* lines : {&report.notes, &report.warnings})
+  {
+    std::vector<std::string> unique;
+    for (const std::string& line : *lines)
+      if (std::find(unique.begin(), unique.end(), line) == unique.end()) unique.push_back(line);
+    lines->swap(unique);
+  }
   return out;
 }
 

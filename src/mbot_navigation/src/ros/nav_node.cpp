@@ -38,9 +38,10 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
 {
   const std::string description_dir = ros::package::getPath("mbot_description");
   if (description_dir.empty()) throw std::runtime_error("cannot find the package mbot_description (robot models)");
-  ParamWarnings warnings;
-  const NavParams params = readNavParams(nh_, private_nh_, description_dir, warnings);
-  for (const std::string& w : warnings) ROS_WARN("%s", w.c_str());
+  ParamReport report;
+  const NavParams params = readNavParams(nh_, private_nh_, description_dir, report);
+  for (const std::string& note : report.notes) ROS_INFO("%s", note.c_str());
+  for (const std::string& w : report.warnings) ROS_WARN("%s", w.c_str());
   robot_ = params.robot;
   controller_patience_ = params.nav.controller_patience;
   const CostmapRosSettings& global_settings = params.global_costmap;
@@ -108,7 +109,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   local_plan_pub_ = private_nh_.advertise<nav_msgs::Path>("local_plan", 1);
   action_goal_pub_ = nh_.advertise<move_base_msgs::MoveBaseActionGoal>("move_base/goal", 1);
   simple_goal_sub_ = nh_.subscribe("move_base_simple/goal", 1, &NavNode::onSimpleGoal, this);
-  odom_sub_ = nh_.subscribe("odom", 1, &NavNode::onOdom, this);
+  odom_sub_ = nh_.subscribe(params.odom_topic, 1, &NavNode::onOdom, this);
   make_plan_srv_ = private_nh_.advertiseService("make_plan", &NavNode::onMakePlan, this);
   clear_costmaps_srv_ = private_nh_.advertiseService("clear_costmaps", &NavNode::onClearCostmaps, this);
   server_ = std::make_unique<ActionServer>(nh_, "move_base", false);

@@ -1,7 +1,8 @@
 // The nav node's parameter reader (move_base_params.h) on a parameter server (rostest
-// move_base_params.test): a tutorial-style move_base set loads with warnings only, each naming
-// its key; a key nobody knows is an error naming it; the plugins form picks the layers; the
-// shipped costmaps (layered) resolve exactly as their pre-layer (flat) form.
+// move_base_params.test): a tutorial-style move_base set loads with notes only, each naming its
+// key; a key nobody knows is a warning naming it and the nearest known key; the plugins form
+// picks the layers; keys costmap_2d searches for upwards are found there; the shipped costmaps
+// (layered) resolve exactly as their pre-layer (flat) form.
 #include <algorithm>
 #include <sstream>
 #include <string>
@@ -20,18 +21,18 @@ namespace
 {
 std::string descriptionDir() { return ros::package::getPath("mbot_description"); }
 
-NavParams read(const std::string& ns, ParamWarnings& warnings)
+NavParams read(const std::string& ns, ParamReport& report)
 {
-  return readNavParams(ros::NodeHandle("/" + ns), ros::NodeHandle("/" + ns + "/move_base"), descriptionDir(), warnings);
+  return readNavParams(ros::NodeHandle("/" + ns), ros::NodeHandle("/" + ns + "/move_base"), descriptionDir(), report);
 }
 
 /// The error text of reading `ns` ("" when it loads).
 std::string readError(const std::string& ns)
 {
-  ParamWarnings warnings;
+  ParamReport report;
   try
   {
-    read(ns, warnings);
+    read(ns, report);
   }
   catch (const std::runtime_error& e)
   {
@@ -40,10 +41,12 @@ std::string readError(const std::string& ns)
   return "";
 }
 
-bool warned(const ParamWarnings& warnings, const std::string& key)
+/// True when one of `lines` is about the parameter `key` (its full name).
+bool mentions(const std::vector<std::string>& lines, const std::string& key)
 {
-  return std::any_of(warnings.begin(), warnings.end(),
-                     [&](const std::string& w) { return w.find(key + ":") != std::string::npos; });
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& line) {
+    return line.find(key + ":") != std::string::npos || line.find(key + " (") != std::string::npos;
+  });
 }
 
 /// Copy the tutorial set of /robot_0/move_base into /<ns>/move_base.
@@ -55,11 +58,11 @@ void copyTutorialSet(const std::string& ns)
 }
 }  // namespace
 
-TEST(MoveBaseParams, TutorialSetLoadsWithWarningsOnly)
+TEST(MoveBaseParams, TutorialSetLoadsWithNotesOnly)
 {
-  ParamWarnings warnings;
+  ParamReport report;
   NavParams p;
-  ASSERT_NO_THROW(p = read("robot_0", warnings));
+  ASSERT_NO_THROW(p = read("robot_0", report));
   // move_base's meanings and units
   EXPECT_EQ(p.global_planner, "astar");  // navfn/NavfnROS
   EXPECT_DOUBLE_EQ(p.controller_frequency, 10.0);
@@ -73,50 +76,153 @@ TEST(MoveBaseParams, TutorialSetLoadsWithWarningsOnly)
   EXPECT_NEAR(p.global_costmap.costmap.robot_radius, std::hypot(0.12, 0.12) + 0.01, 1e-9);  // footprint + padding
   EXPECT_EQ(p.global_costmap.scan_topic, "scan");                                           // from observation_sources
   EXPECT_DOUBLE_EQ(p.global_costmap.obstacle_layer.obstacle_range, 2.5);
+  EXPECT_TRUE(p.global_costmap.obstacle_layer.marking);
+  EXPECT_TRUE(p.global_costmap.obstacle_layer.clearing);
+  EXPECT_FALSE(p.global_costmap.obstacle_layer.inf_is_valid);  // costmap_2d's default
   EXPECT_DOUBLE_EQ(p.global_costmap.inflation_layer.inflation_radius, 0.55);
   EXPECT_DOUBLE_EQ(p.local_costmap.inflation_layer.cost_scaling_factor, 5.0);
   EXPECT_DOUBLE_EQ(p.dwa.max_vel_x, 0.45);
   EXPECT_DOUBLE_EQ(p.dwa.max_vel_theta, 1.5);
   EXPECT_DOUBLE_EQ(p.dwa.xy_goal_tolerance, 0.15);
   EXPECT_EQ(p.dwa.vx_samples, 6);
-  EXPECT_DOUBLE_EQ(p.dwa.controller_frequency, 10.0);  // move_base's, not DWAPlannerROS/controller_frequency
+  EXPECT_DOUBLE_EQ(p.dwa.controller_frequency, 10.0);
+  EXPECT_EQ(p.odom_topic, "odom");
 
+  EXPECT_EQ(report.warnings, std::vector<std::string>{});  // every key is a standard one
   for (const std::string& key :
        {"/robot_0/move_base/conservative_reset_dist", "/robot_0/move_base/shutdown_costmaps",
         "/robot_0/move_base/NavfnROS/default_tolerance", "/robot_0/move_base/NavfnROS/visualize_potential",
         "/robot_0/move_base/DWAPlannerROS/publish_traj_pc", "/robot_0/move_base/DWAPlannerROS/stop_time_buffer",
-        "/robot_0/move_base/DWAPlannerROS/controller_frequency",
         "/robot_0/move_base/global_costmap/always_send_full_costmap",
         "/robot_0/move_base/global_costmap/laser_scan_sensor/sensor_frame",
         "/robot_0/move_base/local_costmap/laser_scan_sensor/expected_update_rate",
         "/robot_0/move_base/local_costmap/global_frame", "/robot_0/move_base/global_costmap/footprint"})
-    EXPECT_TRUE(warned(warnings, key)) << key;
-  // Exactly one warning per ignored key (nothing is reported twice).
-  for (const std::string& w : warnings) EXPECT_EQ(std::count(warnings.begin(), warnings.end(), w), 1) << w;
-  // Implemented keys give no warning.
+    EXPECT_TRUE(mentions(report.notes, key)) << key;
+  // Exactly one note per ignored key (nothing is reported twice).
+  for (const std::string& n : report.notes) EXPECT_EQ(std::count(report.notes.begin(), report.notes.end(), n), 1) << n;
+  // Implemented keys give no note.
   for (const std::string& key :
        {"/robot_0/move_base/DWAPlannerROS/max_vel_x", "/robot_0/move_base/controller_frequency",
-        "/robot_0/move_base/global_costmap/inflation_radius"})
-    EXPECT_FALSE(warned(warnings, key)) << key;
+        "/robot_0/move_base/global_costmap/inflation_radius", "/robot_0/move_base/DWAPlannerROS/controller_frequency"})
+    EXPECT_FALSE(mentions(report.notes, key)) << key;
 }
 
-TEST(MoveBaseParams, UnknownKeyIsAnErrorNamingIt)
+TEST(MoveBaseParams, UnknownKeyIsAWarningNamingItAndTheNearestKnownKey)
 {
+  const std::vector<std::pair<std::string, std::string>> typos = {
+      {"typo/move_base/DWAPlannerROS/max_vel_xx", "max_vel_x"},
+      {"typo/move_base/local_costmap/inflation_raduis", "inflation_radius"},
+      {"typo/move_base/global_costmap/laser_scan_sensor/markign", "marking"},
+      {"typo/move_base/GlobalPlanner/publish_scal", "publish_scale"},
+      {"typo/move_base/TrajectoryPlannerROS/vtheta_sample", "vtheta_samples"},
+      {"typo/move_base/planner_frequncy", "planner_frequency"}};
   copyTutorialSet("typo");
-  ros::param::set("/typo/move_base/DWAPlannerROS/max_vel_xx", 0.3);
-  std::string error = readError("typo");
-  EXPECT_NE(error.find("max_vel_xx"), std::string::npos) << error;
-  EXPECT_NE(error.find("/typo/move_base/DWAPlannerROS"), std::string::npos) << error;
+  for (const auto& typo : typos) ros::param::set("/" + typo.first, 0.3);
+  ParamReport report;
+  NavParams p;
+  ASSERT_NO_THROW(p = read("typo", report));  // as move_base: an unknown key stops nothing
+  for (const auto& typo : typos)
+  {
+    const std::string line = "unknown parameter /" + typo.first + " (ignored; did you mean " + typo.second + "?)";
+    EXPECT_EQ(std::count(report.warnings.begin(), report.warnings.end(), line), 1) << line;
+  }
+  EXPECT_EQ(report.warnings.size(), typos.size());
+  EXPECT_DOUBLE_EQ(p.dwa.max_vel_x, 0.45);  // the rest is read as before
 
-  copyTutorialSet("typo2");
-  ros::param::set("/typo2/move_base/local_costmap/inflation_raduis", 0.3);
-  error = readError("typo2");
-  EXPECT_NE(error.find("inflation_raduis"), std::string::npos) << error;
+  // A wrong value still stops the node, naming the key.
+  copyTutorialSet("bad_type");
+  ros::param::set("/bad_type/move_base/DWAPlannerROS/max_vel_x", std::string("fast"));
+  std::string error = readError("bad_type");
+  EXPECT_NE(error.find("/bad_type/move_base/DWAPlannerROS/max_vel_x"), std::string::npos) << error;
+  copyTutorialSet("bad_range");
+  ros::param::set("/bad_range/move_base/controller_frequency", -1.0);
+  error = readError("bad_range");
+  EXPECT_NE(error.find("/bad_range/move_base/controller_frequency"), std::string::npos) << error;
+}
 
-  copyTutorialSet("typo3");
-  ros::param::set("/typo3/move_base/global_costmap/laser_scan_sensor/markign", true);
-  error = readError("typo3");
-  EXPECT_NE(error.find("markign"), std::string::npos) << error;
+TEST(MoveBaseParams, KeysFoundAsCostmap2dFindsThem)
+{
+  // footprint / robot_radius at the node's level (costmap_2d's searchParam), for both costmaps.
+  copyTutorialSet("search");
+  ros::param::del("/search/move_base/global_costmap/footprint");
+  ros::param::del("/search/move_base/local_costmap/footprint");
+  ros::param::set("/search/move_base/robot_radius", 0.2);
+  ParamReport report;
+  NavParams p = read("search", report);
+  EXPECT_DOUBLE_EQ(p.global_costmap.costmap.robot_radius, 0.2 + 0.01);  // + the costmap's footprint_padding
+  EXPECT_DOUBLE_EQ(p.local_costmap.costmap.robot_radius, 0.2 + 0.01);
+  ros::param::set("/search/move_base/footprint", std::string("[[0.3, 0.0], [-0.1, 0.1], [-0.1, -0.1]]"));
+  report = ParamReport();
+  p = read("search", report);
+  EXPECT_DOUBLE_EQ(p.global_costmap.costmap.robot_radius, 0.3 + 0.01);  // a footprint wins
+  EXPECT_EQ(report.warnings, std::vector<std::string>{});
+  EXPECT_EQ(
+      std::count_if(report.notes.begin(), report.notes.end(),
+                    [](const std::string& n) { return n.find("/search/move_base/footprint:") != std::string::npos; }),
+      1);
+
+  // A source's ranges: its own, else its layer's, the costmap's, the node's; noetic's *_max_range first.
+  copyTutorialSet("ranges");
+  ros::param::del("/ranges/move_base/global_costmap/obstacle_range");
+  ros::param::del("/ranges/move_base/local_costmap/obstacle_range");
+  ros::param::set("/ranges/move_base/obstacle_range", 1.8);
+  ros::param::set("/ranges/move_base/local_costmap/laser_scan_sensor/obstacle_max_range", 1.2);
+  report = ParamReport();
+  p = read("ranges", report);
+  EXPECT_DOUBLE_EQ(p.global_costmap.obstacle_layer.obstacle_range, 1.8);
+  EXPECT_DOUBLE_EQ(p.local_costmap.obstacle_layer.obstacle_range, 1.2);
+  EXPECT_DOUBLE_EQ(p.local_costmap.obstacle_layer.raytrace_range, 3.0);
+  EXPECT_EQ(report.warnings, std::vector<std::string>{});
+
+  // A source without `topic` subscribes to its own name; inf_is_valid, marking and clearing are read.
+  copyTutorialSet("source");
+  ros::param::del("/source/move_base/global_costmap/laser_scan_sensor/topic");
+  ros::param::set("/source/move_base/global_costmap/laser_scan_sensor/inf_is_valid", true);
+  ros::param::set("/source/move_base/global_costmap/laser_scan_sensor/clearing", false);
+  report = ParamReport();
+  p = read("source", report);
+  EXPECT_EQ(p.global_costmap.scan_topic, "laser_scan_sensor");
+  EXPECT_TRUE(p.global_costmap.obstacle_layer.inf_is_valid);
+  EXPECT_FALSE(p.global_costmap.obstacle_layer.clearing);
+  EXPECT_TRUE(p.global_costmap.obstacle_layer.marking);
+  EXPECT_EQ(p.local_costmap.scan_topic, "scan");
+}
+
+TEST(MoveBaseParams, OlderAndOtherPlannersKeysAreAccepted)
+{
+  copyTutorialSet("older");
+  const std::string ns = "/older/move_base/";
+  ros::param::del(ns + "DWAPlannerROS/acc_lim_theta");
+  ros::param::del(ns + "DWAPlannerROS/vth_samples");
+  ros::param::set(ns + "DWAPlannerROS/acc_lim_th", 2.0);     // the wiki's name
+  ros::param::set(ns + "DWAPlannerROS/vtheta_samples", 12);  // base_local_planner's
+  ros::param::set(ns + "DWAPlannerROS/vy_samples", 0);       // raised to 1, as dynamic_reconfigure does
+  ros::param::set(ns + "DWAPlannerROS/sim_period", 0.1);
+  ros::param::set(ns + "DWAPlannerROS/sum_scores", true);
+  ros::param::set(ns + "DWAPlannerROS/odom_topic", std::string("odometry/filtered"));
+  ros::param::set(ns + "GlobalPlanner/publish_scale", 100);
+  ros::param::set(ns + "TrajectoryPlannerROS/pdist_scale", 0.6);
+  ros::param::set(ns + "recovery_behaviors", [] {
+    XmlRpc::XmlRpcValue list;
+    list[0]["name"] = "super_reset";
+    list[0]["type"] = "clear_costmap_recovery/ClearCostmapRecovery";
+    return list;
+  }());
+  ros::param::set(ns + "super_reset/reset_distance", 5.0);
+  ros::param::set(ns + "rotate_recovery/frequency", 20.0);
+  ParamReport report;
+  NavParams p;
+  ASSERT_NO_THROW(p = read("older", report));
+  EXPECT_EQ(report.warnings, std::vector<std::string>{});
+  EXPECT_DOUBLE_EQ(p.dwa.acc_lim_theta, 2.0);
+  EXPECT_EQ(p.dwa.vth_samples, 12);
+  EXPECT_EQ(p.dwa.vy_samples, 1);
+  EXPECT_EQ(p.odom_topic, "odometry/filtered");
+  for (const std::string& key :
+       {"DWAPlannerROS/acc_lim_th", "DWAPlannerROS/vtheta_samples", "DWAPlannerROS/vy_samples",
+        "DWAPlannerROS/sim_period", "DWAPlannerROS/sum_scores", "GlobalPlanner/publish_scale",
+        "TrajectoryPlannerROS/pdist_scale", "recovery_behaviors", "super_reset", "rotate_recovery"})
+    EXPECT_TRUE(mentions(report.notes, ns + key)) << key;
 }
 
 TEST(MoveBaseParams, PlannerNames)
@@ -124,9 +230,9 @@ TEST(MoveBaseParams, PlannerNames)
   copyTutorialSet("gp");
   ros::param::set("/gp/move_base/base_global_planner", std::string("global_planner/GlobalPlanner"));
   ros::param::set("/gp/move_base/GlobalPlanner/use_dijkstra", false);
-  ParamWarnings warnings;
-  EXPECT_EQ(read("gp", warnings).global_planner, "astar");
-  EXPECT_TRUE(warned(warnings, "/gp/move_base/GlobalPlanner/use_dijkstra"));
+  ParamReport report;
+  EXPECT_EQ(read("gp", report).global_planner, "astar");
+  EXPECT_TRUE(mentions(report.notes, "/gp/move_base/GlobalPlanner/use_dijkstra"));
 
   copyTutorialSet("carrot");
   ros::param::set("/carrot/move_base/base_global_planner", std::string("carrot_planner/CarrotPlanner"));
@@ -141,9 +247,9 @@ TEST(MoveBaseParams, PlannerNames)
 
 TEST(MoveBaseParams, PluginsPickTheLayers)
 {
-  ParamWarnings warnings;
+  ParamReport report;
   CostmapRosSettings d;
-  const CostmapRosSettings s = readCostmapSettings(ros::NodeHandle("/plugins/move_base/global_costmap"), d, &warnings);
+  const CostmapRosSettings s = readCostmapSettings(ros::NodeHandle("/plugins/move_base/global_costmap"), d, &report);
   EXPECT_TRUE(s.static_map);
   EXPECT_EQ(s.scan_topic, "scan");
   EXPECT_DOUBLE_EQ(s.obstacle_layer.obstacle_range, 2.0);  // the source's own
@@ -154,9 +260,10 @@ TEST(MoveBaseParams, PluginsPickTheLayers)
   EXPECT_DOUBLE_EQ(s.inflation_layer.inflation_radius, 0.4);  // the layer's, not the flat 0.9
   EXPECT_DOUBLE_EQ(s.inflation_layer.cost_scaling_factor, 8.0);
   EXPECT_DOUBLE_EQ(s.costmap.robot_radius, 0.17);
-  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/inflation_radius"));
-  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/static_layer/subscribe_to_updates"));
-  EXPECT_TRUE(warned(warnings, "/plugins/move_base/global_costmap/obstacle_layer/z_voxels"));
+  EXPECT_TRUE(mentions(report.notes, "/plugins/move_base/global_costmap/inflation_radius"));
+  EXPECT_TRUE(mentions(report.notes, "/plugins/move_base/global_costmap/static_layer/subscribe_to_updates"));
+  EXPECT_TRUE(mentions(report.notes, "/plugins/move_base/global_costmap/obstacle_layer/z_voxels"));
+  EXPECT_EQ(report.warnings, std::vector<std::string>{});
 
   // A layer left out is not there; `enabled: false` turns one off.
   ros::param::set("/plugins2/global_costmap/plugins", [] {
@@ -168,8 +275,8 @@ TEST(MoveBaseParams, PluginsPickTheLayers)
     return list;
   }());
   ros::param::set("/plugins2/global_costmap/inflation_layer/enabled", false);
-  warnings.clear();
-  const CostmapRosSettings s2 = readCostmapSettings(ros::NodeHandle("/plugins2/global_costmap"), d, &warnings);
+  report = ParamReport();
+  const CostmapRosSettings s2 = readCostmapSettings(ros::NodeHandle("/plugins2/global_costmap"), d, &report);
   EXPECT_TRUE(s2.static_map);
   EXPECT_TRUE(s2.scan_topic.empty());
   EXPECT_FALSE(s2.robots_layer);
@@ -184,7 +291,7 @@ TEST(MoveBaseParams, PluginsPickTheLayers)
   }());
   try
   {
-    readCostmapSettings(ros::NodeHandle("/plugins3/global_costmap"), d, &warnings);
+    readCostmapSettings(ros::NodeHandle("/plugins3/global_costmap"), d, &report);
     FAIL() << "an unknown layer type was accepted";
   }
   catch (const std::runtime_error& e)
@@ -259,8 +366,11 @@ TEST(MoveBaseParams, MovingObstaclesLayerKeysAndErrors)
   EXPECT_NE(error.find("'max_speed'"), std::string::npos) << error;
   setMovingPlugins("moving_typo", true);
   ros::param::set("/moving_typo/global_costmap/people/min_sped", 0.3);
-  error = settingsError("/moving_typo/global_costmap");
-  EXPECT_NE(error.find("min_sped"), std::string::npos) << error;
+  ParamReport typo_report;
+  readCostmapSettings(ros::NodeHandle("/moving_typo/global_costmap"), CostmapRosSettings(), &typo_report);
+  EXPECT_EQ(typo_report.warnings,
+            std::vector<std::string>{"unknown parameter /moving_typo/global_costmap/people/min_sped (ignored; did you "
+                                     "mean min_speed?)"});
 
   // The flat form: moving_obstacles_<key>.
   ros::param::set("/moving_flat/global_costmap/moving_obstacles_association_gate", -0.5);
@@ -313,11 +423,11 @@ TEST(MoveBaseParams, LayersAreStackedInTheListedOrder)
   d.costmap.rolling_window = true;  // no map needed
   d.costmap.width = d.costmap.height = 4.0;
   d.costmap.robot_radius = 0.15;
-  ParamWarnings warnings;
+  ParamReport report;
   ros::param::set("/order_last/global_costmap/plugins", robotsAndInflation(true));
   ros::param::set("/order_first/global_costmap/plugins", robotsAndInflation(false));
-  const CostmapRosSettings last = readCostmapSettings(ros::NodeHandle("/order_last/global_costmap"), d, &warnings);
-  const CostmapRosSettings first = readCostmapSettings(ros::NodeHandle("/order_first/global_costmap"), d, &warnings);
+  const CostmapRosSettings last = readCostmapSettings(ros::NodeHandle("/order_last/global_costmap"), d, &report);
+  const CostmapRosSettings first = readCostmapSettings(ros::NodeHandle("/order_first/global_costmap"), d, &report);
   EXPECT_EQ(last.layer_order, (std::vector<LayerKind>{LayerKind::ROBOTS, LayerKind::INFLATION}));
   EXPECT_EQ(first.layer_order, (std::vector<LayerKind>{LayerKind::INFLATION, LayerKind::ROBOTS}));
   ASSERT_TRUE(last.inflation && last.robots_layer && first.inflation && first.robots_layer);
@@ -384,6 +494,9 @@ std::vector<std::string> differences(const CostmapRosSettings& a, const CostmapR
           b.obstacle_layer.track_unknown_space);
   compare("obstacle_layer.footprint_clearing_enabled", a.obstacle_layer.footprint_clearing_enabled,
           b.obstacle_layer.footprint_clearing_enabled);
+  compare("obstacle_layer.marking", a.obstacle_layer.marking, b.obstacle_layer.marking);
+  compare("obstacle_layer.clearing", a.obstacle_layer.clearing, b.obstacle_layer.clearing);
+  compare("obstacle_layer.inf_is_valid", a.obstacle_layer.inf_is_valid, b.obstacle_layer.inf_is_valid);
   compare("inflation", a.inflation, b.inflation);
   compare("inflation_layer.inflation_radius", a.inflation_layer.inflation_radius, b.inflation_layer.inflation_radius);
   compare("inflation_layer.cost_scaling_factor", a.inflation_layer.cost_scaling_factor,
@@ -424,12 +537,16 @@ TEST(MoveBaseParams, ShippedLayeredCostmapsResolveAsTheirFlatForm)
   ASSERT_FALSE(ros::param::has("/flat/move_base/global_costmap/plugins"));
   ASSERT_FALSE(ros::param::has("/flat/move_base/local_costmap/plugins"));
 
-  ParamWarnings shipped_warnings, flat_warnings;
+  ParamReport shipped_report, flat_report;
   NavParams shipped, flat;
-  ASSERT_NO_THROW(shipped = read("shipped", shipped_warnings));
-  ASSERT_NO_THROW(flat = read("flat", flat_warnings));
-  EXPECT_EQ(shipped_warnings, ParamWarnings{});  // the node starts without a warning
-  EXPECT_EQ(flat_warnings, ParamWarnings{});
+  ASSERT_NO_THROW(shipped = read("shipped", shipped_report));
+  ASSERT_NO_THROW(flat = read("flat", flat_report));
+  // The node starts without a warning or a note.
+  EXPECT_EQ(shipped_report.warnings, std::vector<std::string>{});
+  EXPECT_EQ(shipped_report.notes, std::vector<std::string>{});
+  EXPECT_EQ(flat_report.warnings, std::vector<std::string>{});
+  EXPECT_EQ(flat_report.notes, std::vector<std::string>{});
+  EXPECT_TRUE(shipped.local_costmap.obstacle_layer.inf_is_valid);  // the simulator's +Inf clears
 
   for (const std::string& d : differences(shipped.global_costmap, flat.global_costmap))
     ADD_FAILURE() << "global_costmap " << d << " (shipped vs flat)";

@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "mbot_navigation/costmap/inflation_layer.h"
@@ -180,9 +181,18 @@ TEST_F(ObstacleLayerTest, MarksHitThenLaterBeamThroughItClearsIt)
   EXPECT_EQ(at(3.025, 1.025), cost::LETHAL);
 }
 
-TEST_F(ObstacleLayerTest, InfiniteBeamClearsUpToRaytraceRangeButMarksNothing)
+namespace
 {
-  // Marks at 2.0 m and 3.5 m along +x from the sensor.
+/// An obstacle layer (inf_is_valid as given) with marks 2.0 m and 3.5 m along +x from the sensor at
+/// (0.525, 2.025), then one +Inf beam along +x from there (range_max as given).
+/// @return the costs at 2.0 m and 3.5 m, and the number of LETHAL cells.
+std::tuple<int, int, int> afterANoReturnBeam(bool inf_is_valid, double range_max)
+{
+  LayeredCostmap costmap(staticConfig(6.0, 6.0, 0.0));
+  ObstacleLayerConfig oc;
+  oc.inf_is_valid = inf_is_valid;
+  auto& layer = static_cast<ObstacleLayer&>(costmap.addLayer(std::make_unique<ObstacleLayer>(oc)));
+  const Pose2D robot{0.5, 0.5, 0.0};
   ScanObservation marks;
   marks.origin_x = 0.525;
   marks.origin_y = 2.025;
@@ -191,21 +201,66 @@ TEST_F(ObstacleLayerTest, InfiniteBeamClearsUpToRaytraceRangeButMarksNothing)
   far_mark.origin_x = 2.525;
   far_mark.origin_y = 3.025;
   far_mark.addEndpoint(4.025, 2.025);
-  scan(marks);
-  scan(far_mark);
-  ASSERT_EQ(at(2.525, 2.025), cost::LETHAL);
-  ASSERT_EQ(at(4.025, 2.025), cost::LETHAL);
+  layer.addObservation(marks);
+  layer.addObservation(far_mark);
+  costmap.updateMap(robot);
+  EXPECT_EQ(costAt(costmap.costmap(), 2.525, 2.025), cost::LETHAL);
+  EXPECT_EQ(costAt(costmap.costmap(), 4.025, 2.025), cost::LETHAL);
 
   ScanObservation none;
   none.origin_x = 0.525;
   none.origin_y = 2.025;
+  none.range_max = range_max;
   none.addNoReturn(0.0);  // +Inf along +x
-  scan(none);
-  EXPECT_EQ(at(2.525, 2.025), cost::FREE);    // 2.0 m < raytrace_range 3.0: cleared
-  EXPECT_EQ(at(4.025, 2.025), cost::LETHAL);  // 3.5 m > raytrace_range: untouched
+  layer.addObservation(none);
+  costmap.updateMap(robot);
   int lethal = 0;
-  for (unsigned i = 0; i < 120 * 120; ++i) lethal += costmap->costmap().data()[i] == cost::LETHAL;
-  EXPECT_EQ(lethal, 1);  // the +Inf beam marked nothing
+  for (unsigned i = 0; i < 120 * 120; ++i) lethal += costmap.costmap().data()[i] == cost::LETHAL;
+  return {costAt(costmap.costmap(), 2.525, 2.025), costAt(costmap.costmap(), 4.025, 2.025), lethal};
+}
+}  // namespace
+
+TEST(ObstacleLayerInf, NoReturnBeamIsIgnoredByDefaultAsInCostmap2d)
+{
+  // costmap_2d's inf_is_valid defaults to false: a +Inf reading neither clears nor marks.
+  EXPECT_FALSE(ObstacleLayerConfig().inf_is_valid);
+  EXPECT_EQ(afterANoReturnBeam(false, 8.0), std::make_tuple(int(cost::LETHAL), int(cost::LETHAL), 2));
+}
+
+TEST(ObstacleLayerInf, NoReturnBeamWithInfIsValidClearsUpToRaytraceRange)
+{
+  // A reading at range_max (8 m): clears to raytrace_range (3.0 m), marks nothing (beyond 2.5 m).
+  EXPECT_EQ(afterANoReturnBeam(true, 8.0), std::make_tuple(int(cost::FREE), int(cost::LETHAL), 1));
+  // An infinite range_max: the same.
+  EXPECT_EQ(afterANoReturnBeam(true, kInf), std::make_tuple(int(cost::FREE), int(cost::LETHAL), 1));
+  // As in costmap_2d, a range_max within obstacle_range is a hit there: 1.5 m along +x is marked.
+  EXPECT_EQ(std::get<2>(afterANoReturnBeam(true, 1.5)), 3);
+}
+
+TEST(ObstacleLayerInf, MarkingAndClearingCanBeSwitchedOff)
+{
+  for (const bool marking : {true, false})
+    for (const bool clearing : {true, false})
+    {
+      LayeredCostmap costmap(staticConfig(6.0, 6.0, 0.0));
+      ObstacleLayerConfig oc;
+      oc.marking = marking;
+      oc.clearing = clearing;
+      auto& layer = static_cast<ObstacleLayer&>(costmap.addLayer(std::make_unique<ObstacleLayer>(oc)));
+      ScanObservation first, second;  // a hit at 1 m, then a beam through it to 2 m
+      first.origin_x = second.origin_x = 1.025;
+      first.origin_y = second.origin_y = 1.025;
+      first.addEndpoint(2.025, 1.025);
+      second.addEndpoint(3.025, 1.025);
+      layer.addObservation(first);
+      costmap.updateMap(Pose2D{0.5, 0.5, 0.0});
+      EXPECT_EQ(costAt(costmap.costmap(), 2.025, 1.025), marking ? cost::LETHAL : cost::FREE);
+      layer.addObservation(second);
+      costmap.updateMap(Pose2D{0.5, 0.5, 0.0});
+      EXPECT_EQ(costAt(costmap.costmap(), 2.025, 1.025), marking && !clearing ? cost::LETHAL : cost::FREE)
+          << marking << clearing;
+      EXPECT_EQ(costAt(costmap.costmap(), 3.025, 1.025), marking ? cost::LETHAL : cost::FREE);
+    }
 }
 
 TEST_F(ObstacleLayerTest, ObstacleRangeAndInvalidRanges)
@@ -228,10 +283,12 @@ TEST_F(ObstacleLayerTest, ObstacleRangeAndInvalidRanges)
 /// A wall of 41 cells (x = 2.525 m, y from 1.025 to 3.025 m) scanned 50 times from (0.525, 2.025)
 /// by one beam per wall cell, each beam dropping out with probability 0.3 and then reading
 /// `dropped` instead of its range. @return how many wall cells are LETHAL after the last scan.
-int wallCellsLeftUnderDropout(double dropped)
+int wallCellsLeftUnderDropout(double dropped, bool inf_is_valid = false)
 {
   LayeredCostmap costmap(staticConfig(6.0, 6.0, 0.0));
-  auto& layer = static_cast<ObstacleLayer&>(costmap.addLayer(std::make_unique<ObstacleLayer>()));
+  ObstacleLayerConfig oc;
+  oc.inf_is_valid = inf_is_valid;
+  auto& layer = static_cast<ObstacleLayer&>(costmap.addLayer(std::make_unique<ObstacleLayer>(oc)));
   const Pose2D robot{0.525, 2.025, 0.0};
   costmap.updateMap(robot);
   std::mt19937 rng(7);
@@ -259,9 +316,11 @@ TEST(ObstacleLayerDropout, NaNBeamsNeitherMarkNorClearSoAnObstacleStays)
 {
   // REP-117: a dropped beam (NaN, "invalid") says nothing; the wall stays whole.
   EXPECT_EQ(wallCellsLeftUnderDropout(std::nan("")), 41);
-  // What +Inf ("nothing in range") would do instead: it clears the cells it passes, so the last
-  // scan's dropped beams erase about 30 % of the wall (the reason dropouts must not be +Inf).
-  const int left_with_inf = wallCellsLeftUnderDropout(kInf);
+  // +Inf ("nothing in range") is ignored too unless inf_is_valid is set, as in costmap_2d.
+  EXPECT_EQ(wallCellsLeftUnderDropout(kInf), 41);
+  // With inf_is_valid it clears the cells it passes, so the last scan's dropped beams erase
+  // about 30 % of the wall (the reason dropouts must not be +Inf).
+  const int left_with_inf = wallCellsLeftUnderDropout(kInf, true);
   EXPECT_LT(left_with_inf, 38);
   EXPECT_GT(left_with_inf, 20);
 }

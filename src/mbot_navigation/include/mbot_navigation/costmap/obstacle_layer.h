@@ -5,8 +5,10 @@
  *
  * Every update first clears the cells that the beams passed through, then marks the cells they
  * hit, so that a hit of this scan is never cleared by another beam of the same scan. Ranges follow
- * REP-117: +Inf means "no return within range_max" (clear up to raytrace_range, mark nothing),
- * -Inf means "too close to measure" and NaN means "invalid" (both ignored).
+ * REP-117: -Inf means "too close to measure" and NaN means "invalid" (both ignored); +Inf means
+ * "no return within range_max", which costmap_2d ignores too unless `inf_is_valid` is set: then
+ * the beam counts as a reading at range_max (it clears up to there, and a range_max within
+ * obstacle_range is even marked, as in costmap_2d).
  */
 #pragma once
 
@@ -25,6 +27,9 @@ struct ObstacleLayerConfig
   double raytrace_range = 3.0;             ///< clear free space no further than this [m]
   bool track_unknown_space = false;        ///< never-seen cells: NO_INFORMATION (true) or FREE (false)
   bool footprint_clearing_enabled = true;  ///< clear the cells under the robot (robot_radius)
+  bool marking = true;                     ///< hits mark their cells (the source's `marking`)
+  bool clearing = true;                    ///< beams clear the cells they cross (the source's `clearing`)
+  bool inf_is_valid = false;               ///< +Inf is a reading at range_max (costmap_2d's default: ignored)
 };
 
 /// @brief One beam: a direction and a range, REP-117 semantics for the range.
@@ -75,6 +80,9 @@ private:
   /// @brief Set the cells of the segment (x0, y0) -> (x1, y1) [m], clipped to the grid, to FREE;
   ///        the end cell is kept when `keep_end` (it holds the hit).
   void raytrace(double x0, double y0, double x1, double y1, bool keep_end, Bounds& bounds);
+  /// The range to use for a beam: NaN for a beam to skip, +Inf for a no-return beam with
+  /// inf_is_valid and an infinite range_max, else a finite range.
+  double usableRange(double range, const ScanObservation& scan) const;
   uint8_t unknownValue() const { return config_.track_unknown_space ? cost::NO_INFORMATION : cost::FREE; }
 
   ObstacleLayerConfig config_;

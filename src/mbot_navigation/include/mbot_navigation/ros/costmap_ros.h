@@ -105,14 +105,16 @@ struct CostmapRosSettings
                                      LayerKind::INFLATION};
 };
 
+struct ParamReport;  // move_base_params.h
+
 /**
- * @brief Read ~<name>/ (see the file comment) strictly: a wrong type or an unknown key throws
- *        std::runtime_error naming the parameter; a standard costmap_2d key that this node does
- *        not implement adds one line to `warnings` (when given) and is ignored.
+ * @brief Read ~<name>/ (see the file comment): a wrong type or a bad value throws
+ *        std::runtime_error naming the parameter; an unknown key adds a warning to `report` (when
+ *        given), a standard costmap_2d key that this node ignores or approximates a note.
  * @param defaults the values of keys that are not set (the caller fills robot_radius, frames...)
  */
 CostmapRosSettings readCostmapSettings(const ros::NodeHandle& costmap_nh, const CostmapRosSettings& defaults,
-                                       std::vector<std::string>* warnings = nullptr);
+                                       ParamReport* report = nullptr);
 
 /// @brief costmap_2d's translation of a cost to an OccupancyGrid value: 0 -> 0, 1..252 -> 1..98,
 ///        INSCRIBED -> 99, LETHAL -> 100, NO_INFORMATION -> -1.

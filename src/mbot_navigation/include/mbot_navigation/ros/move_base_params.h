@@ -4,11 +4,13 @@
  *        costmaps (costmap_ros.h), global_planner / navfn and dwa_local_planner keys, with their
  *        meanings and units, so that a parameter set written for move_base loads unchanged.
  *
- * Three kinds of key (the table is docs/move_base_keys.md):
+ * Keys are (the tables are docs/move_base_keys.md):
  *   - implemented: read, with move_base's meaning;
- *   - a standard key this node does not implement (say DWAPlannerROS/publish_traj_pc): one
- *     warning naming it, then ignored;
- *   - anything else: an error naming it (typos stop the node).
+ *   - approximated: read, and one note (ROS_INFO) says how this node differs;
+ *   - accepted and ignored: a standard key this node does not implement (say
+ *     DWAPlannerROS/publish_traj_pc): one note naming it;
+ *   - unknown: one warning naming it and the nearest known key, then ignored, as move_base
+ *     ignores keys it does not read. Only a wrong value (type, range) stops the node.
  * Standard planner names map to ours: navfn/NavfnROS and global_planner/GlobalPlanner -> astar,
  * dwa_local_planner/DWAPlannerROS -> dwa. base_local_planner/TrajectoryPlannerROS is not supported.
  */
@@ -35,17 +37,33 @@ struct RobotModel;
 
 namespace mbot_navigation
 {
-/// @brief Warnings collected while reading (one per ignored key); the node logs each.
-using ParamWarnings = std::vector<std::string>;
+/// @brief What reading the parameters has to tell, besides errors (which throw); the node logs it.
+struct ParamReport
+{
+  std::vector<std::string> warnings;  ///< unknown keys, each with the nearest known key (ROS_WARN)
+  std::vector<std::string> notes;     ///< standard keys ignored or approximated here (ROS_INFO)
+};
 
 /**
- * @brief Keys of `p`'s namespace that are standard but not implemented: each one that is set is
- *        counted as known, and gives one warning "<full name>: <what> that this node does not
- *        implement; ignored".
+ * @brief Keys of `p`'s namespace that are standard but not implemented: each is counted as known
+ *        (also for the suggestions), and each one that is set gives one note
+ *        "parameter <full name>: <what> that this node does not implement; ignored".
  * @param what e.g. "a dwa_local_planner key"
  */
 void ignoreStandardKeys(mbot_common::StrictParams& p, const ros::NodeHandle& nh, const std::vector<std::string>& keys,
-                        const std::string& what, ParamWarnings& warnings);
+                        const std::string& what, ParamReport& report);
+
+/// @brief Add a warning for each key of `p`'s namespace that nobody read (`p` in UnknownKeys::WARN).
+void reportUnknownKeys(const mbot_common::StrictParams& p, ParamReport& report);
+
+/**
+ * @brief costmap_2d's searchParam(): the value of `key` in `from`'s namespace or the nearest one
+ *        above it (the node's, the robot's, ...).
+ * @param found the full name found ("" when none: then `default_value`)
+ * @throws std::runtime_error naming the parameter when it is not a number
+ */
+double searchDouble(const ros::NodeHandle& from, const std::string& key, double default_value,
+                    std::string* found = nullptr);
 
 /// @brief "astar" or "ompl" for move_base's `base_global_planner` (our names or the standard
 ///        plugin names); @throws std::runtime_error naming the parameter otherwise.
@@ -76,16 +94,17 @@ struct NavParams
   CostmapRosSettings global_costmap, local_costmap;
   GlobalPlannerParams planners;
   DwaConfig dwa;
+  std::string odom_topic = "odom";  ///< DWAPlannerROS/odom_topic: the velocity, in the robot's namespace
 };
 
 /**
  * @brief Read and check every parameter of the nav node in `private_nh` (the robot's namespace
  *        is `nh`), strictly (see the file comment).
  * @param description_dir the mbot_description package (robot models)
- * @throws std::runtime_error naming the parameter for an unknown key, a wrong type or a bad value
+ * @throws std::runtime_error naming the parameter for a wrong type or a bad value
  */
 NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
-                        const std::string& description_dir, ParamWarnings& warnings);
+                        const std::string& description_dir, ParamReport& report);
 
 // dynamic_reconfigure (cfg/DWAPlanner.cfg, cfg/Inflation.cfg) <-> the settings structs.
 /// @brief The reconfigurable DWA settings of `dwa`, with dwa_local_planner's names.
