@@ -28,16 +28,9 @@ std::string stripSlash(std::string frame)
 const std::vector<std::string> kIgnoredCostmapKeys = {"always_send_full_costmap"};
 const std::vector<std::string> kIgnoredStaticKeys = {"first_map_only", "subscribe_to_updates", "use_maximum"};
 // Obstacle (and voxel) layer keys: this layer is 2-D, fed by one laser, always combined by maximum.
-const std::vector<std::string> kIgnoredObstacleKeys = {"max_obstacle_height",
-                                                       "min_obstacle_height",
-                                                       "combination_method",
-                                                       "transform_tolerance",
-                                                       "origin_z",
-                                                       "z_resolution",
-                                                       "z_voxels",
-                                                       "unknown_threshold",
-                                                       "mark_threshold",
-                                                       "publish_voxel_map"};
+const std::vector<std::string> kIgnoredObstacleKeys = {
+    "max_obstacle_height", "min_obstacle_height", "combination_method", "origin_z", "z_resolution", "z_voxels",
+    "unknown_threshold",   "mark_threshold",      "publish_voxel_map"};
 const std::vector<std::string> kIgnoredSourceKeys = {
     "sensor_frame",        "observation_persistence", "expected_update_rate", "min_obstacle_height",
     "max_obstacle_height", "obstacle_min_range",      "raytrace_min_range"};
@@ -275,6 +268,8 @@ void readPlugins(StrictParams& p, const ros::NodeHandle& nh, CostmapRosSettings&
           throw std::runtime_error("layer " + layer_nh.getNamespace() + " (" + type +
                                    "): expected observation_sources (or scan_topic)");
         readObstacleLayer(lp, layer_nh, s, r);
+        // The layer's own tf tolerance (a costmap-level one is the costmap's, implemented).
+        ignoreStandardKeys(lp, layer_nh, {"transform_tolerance"}, "a costmap_2d obstacle layer key", r);
         if (!enabled) s.scan_topic.clear();
         break;
       case LayerKind::INFLATION:

@@ -80,7 +80,7 @@ class NavNode
 {
 public:
   /// @brief Read the parameters and set everything up.
-  /// @throws std::runtime_error naming the parameter for a bad or unknown parameter
+  /// @throws std::runtime_error naming the parameter for a bad value (an unknown key is a warning)
   NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
 private:
