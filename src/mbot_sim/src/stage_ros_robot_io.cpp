@@ -1,7 +1,7 @@
 /**
  * @file stage_ros_robot_io.cpp
  * @brief Each robot's topics: its publishers and subscribers, sensor samples -> messages, and
- *        the commands it takes (cmd_vel, cmd_pose). See stage_ros.h.
+ *        the commands it takes (cmd_vel, cmd_pose, cmd_pose_stamped). See stage_ros.h.
  */
 #include "mbot_sim/stage_ros.h"
 
@@ -49,7 +49,11 @@ void StageRos::addRobotIo(int id)
       ns + "cmd_vel", 1, [this, id](const geometry_msgs::Twist::ConstPtr& msg) { onCmdVel(id, msg); },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
   io->cmd_pose = nh_.subscribe<geometry_msgs::Pose>(
-      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose::ConstPtr& msg) { onCmdPose(id, msg); });
+      ns + "cmd_pose", 1, [this, id](const geometry_msgs::Pose::ConstPtr& msg) { onCmdPose(id, *msg, "cmd_pose"); });
+  // As stage_ros: the header is ignored, the pose is in the map frame like cmd_pose's.
+  io->cmd_pose_stamped = nh_.subscribe<geometry_msgs::PoseStamped>(
+      ns + "cmd_pose_stamped", 1,
+      [this, id](const geometry_msgs::PoseStamped::ConstPtr& msg) { onCmdPose(id, msg->pose, "cmd_pose_stamped"); });
 
   // Message parts that never change, filled once.
   const mbot_description::RobotModel& m = world_->robotModel(id);
@@ -136,25 +140,28 @@ void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
   io_[robot]->cmd_unused = true;
 }
 
-/// As stage_ros: a geometry_msgs/Pose in the map frame; z, roll and pitch are ignored.
-void StageRos::onCmdPose(int robot, const geometry_msgs::Pose::ConstPtr& msg)
+/// As stage_ros: a pose in the map frame; z, roll and pitch are ignored. The robot is moved at
+/// once, at rest, and its odometry moves with it (the odom frame stays put in the map), as a
+/// Stage robot's does with Stage's default localization "gps" (odometry = the true pose), which
+/// stage_ros's own worlds use. /teleport_robot leaves the odometry alone (a kidnapping).
+void StageRos::onCmdPose(int robot, const geometry_msgs::Pose& pose, const char* topic)
 {
   if (!world_->hasRobot(robot)) return;
-  const geometry_msgs::Quaternion& q = msg->orientation;
+  const geometry_msgs::Quaternion& q = pose.orientation;
   const double yaw = mbot_common::yawOf(q.x, q.y, q.z, q.w);
   if (std::isnan(yaw))
   {
-    ROS_WARN("stage_node: cmd_pose: %s: the orientation is not a rotation (zero or NaN quaternion)",
+    ROS_WARN("stage_node: %s: %s: the orientation is not a rotation (zero or NaN quaternion)", topic,
              world_->robotName(robot).c_str());
     return;
   }
   try
   {
-    world_->teleport(world_->robotName(robot), Pose2D{msg->position.x, msg->position.y, yaw});
+    world_->teleport(world_->robotName(robot), Pose2D{pose.position.x, pose.position.y, yaw}, true);
   }
   catch (const std::exception& e)
   {
-    ROS_WARN("stage_node: cmd_pose: %s", e.what());
+    ROS_WARN("stage_node: %s: %s", topic, e.what());
   }
 }
 

@@ -1023,6 +1023,7 @@ TEST(Requests, SpawnTeleportRemoveAndTheirErrors)
   EXPECT_NEAR(world.groundTruth(b).x, 5.0, 1e-9);
   EXPECT_NEAR(world.groundTruth(b).theta, 1.0, 1e-9);
   EXPECT_NEAR(world.odometry(b).x, 0.0, 1e-9);  // a kidnapping: the wheels did not turn
+  EXPECT_NEAR(world.odometry(b).theta, 0.0, 1e-9);
 
   FaultConfig bad;
   bad.laser_dropout = 1.5;
@@ -1073,6 +1074,37 @@ std::string errorOf(F f)
   }
   ADD_FAILURE() << "expected a SimError";
   return "";
+}
+
+// stage_node's cmd_pose and cmd_pose_stamped: the odometry moves with the robot, the odom frame
+// stays where it is in the map (stage_ros with Stage's default "gps" localization).
+TEST(Requests, TeleportWithOdometryFollowingKeepsTheOdomFrameInTheMap)
+{
+  World world(roomMap(), WorldSettings{});
+  Recorder rec;
+  world.setListener(&rec);
+  const int id = world.addRobot("robot_0", diffModel(), Pose2D{2.0, 2.0, 0.5});
+  drive(world, id, Twist2D{0.3, 0.0, 0.4}, 2.0);
+  run(world, 1.0);  // at rest
+  const Pose2D odom_frame = mbot_common::compose(world.groundTruth(id), mbot_common::inverse(world.odometry(id)));
+  const Pose2D target{5.0, 6.0, -2.0};
+  world.teleport("robot_0", target, true);
+  world.step();
+  const Pose2D truth = world.groundTruth(id);
+  EXPECT_NEAR(truth.x, target.x, 1e-9);
+  EXPECT_NEAR(truth.y, target.y, 1e-9);
+  EXPECT_NEAR(truth.theta, target.theta, 1e-9);
+  // the odometry jumped with the robot: map -> odom is unchanged
+  const Pose2D odom_frame_after = mbot_common::compose(truth, mbot_common::inverse(world.odometry(id)));
+  EXPECT_NEAR(odom_frame_after.x, odom_frame.x, 1e-9);
+  EXPECT_NEAR(odom_frame_after.y, odom_frame.y, 1e-9);
+  EXPECT_NEAR(mbot_common::normalizeAngle(odom_frame_after.theta - odom_frame.theta), 0.0, 1e-9);
+  // at rest at once: true zeros
+  run(world, 0.1);
+  EXPECT_EQ(rec.odom[id].back().twist.vx, 0.0);
+  EXPECT_EQ(rec.odom[id].back().twist.wz, 0.0);
+  EXPECT_EQ(rec.truth[id].back().twist.vx, 0.0);
+  EXPECT_EQ(rec.truth[id].back().twist.wz, 0.0);
 }
 
 TEST(Requests, SpawnedObstacleIsSeenFromTheNextScanAndGoneAfterRemoval)

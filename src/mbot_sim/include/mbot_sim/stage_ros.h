@@ -11,6 +11,7 @@
 
 #include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/Pose.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <mbot_msgs/RemoveObstacle.h>
@@ -99,7 +100,7 @@ private:
     std::string name;
     std::string prefix;  ///< "<name>/" for frame ids
     ros::Publisher odom, ground_truth, scan, joint_states;
-    ros::Subscriber cmd_vel, cmd_pose;
+    ros::Subscriber cmd_vel, cmd_pose, cmd_pose_stamped;
     nav_msgs::Odometry odom_msg, ground_truth_msg;
     sensor_msgs::LaserScan scan_msg;
     sensor_msgs::JointState joint_msg;
@@ -124,7 +125,8 @@ private:
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg);
   void onHeartbeat(const std_msgs::Header::ConstPtr& msg);
   bool localizationCurrent(const RobotIo& io) const;
-  void onCmdPose(int robot, const geometry_msgs::Pose::ConstPtr& msg);
+  /// cmd_pose and cmd_pose_stamped (`topic` names which, for the log).
+  void onCmdPose(int robot, const geometry_msgs::Pose& pose, const char* topic);
   bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onPause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
   bool onUnpause(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);

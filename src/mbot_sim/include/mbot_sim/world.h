@@ -180,9 +180,12 @@ public:
   /// @brief The velocity the robot should drive (clamped to its limits, reached within its
   ///        acceleration limits); it stops when no command comes for watchdog_timeout.
   void setCommand(int robot, const Twist2D& command);
-  /// @brief Move a robot to `pose` at once, at rest; its odometry is not changed (as a kidnapping).
+  /// @brief Move a robot to `pose` at once, at rest. Its odometry is not changed (a kidnapping:
+  ///        the wheels did not turn), or with `odometry_follows` it moves with the robot: the
+  ///        odom frame stays where it is in the map, as stage_ros's cmd_pose does with Stage's
+  ///        default localization ("gps": odometry = the true pose).
   /// @throws SimError: unknown robot, pose outside the map or overlapping another body
-  void teleport(const std::string& name, const Pose2D& pose);
+  void teleport(const std::string& name, const Pose2D& pose, bool odometry_follows = false);
   /// @brief Replace all faults of a robot (a default FaultConfig clears them).
   /// @throws SimError: unknown robot, a value out of range
   void setFaults(const std::string& name, const FaultConfig& faults);

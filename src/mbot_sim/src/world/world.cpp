@@ -413,7 +413,7 @@ struct World::Impl
     r.command_time = time();
   }
 
-  void teleport(const std::string& name, const Pose2D& pose)
+  void teleport(const std::string& name, const Pose2D& pose, bool odometry_follows)
   {
     Robot& r = needRobot(name);
     if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
@@ -421,7 +421,13 @@ struct World::Impl
     if (!insideMap(pose.x, pose.y)) throw SimError("pose " + formatPoint(pose.x, pose.y) + " is outside the map");
     if (const BodyTag* other = overlapping(r.outline, pose, &r.tag, true))
       throw SimError("robot " + name + " at " + formatPoint(pose.x, pose.y) + " would overlap " + other->describe());
+    const Pose2D odom_frame = mbot_common::compose(r.pose, mbot_common::inverse(r.odom));  // in the map
     placeBody(r, pose);
+    if (odometry_follows)
+    {
+      r.odom = mbot_common::relative(odom_frame, r.pose);
+      r.odom_twist = Twist2D{};
+    }
   }
 
   void setFaults(const std::string& name, const FaultConfig& faults)
@@ -538,7 +544,10 @@ void World::addObstacle(const ObstacleConfig& obstacle) { impl_->addObstacle(obs
 void World::removeObstacle(const std::string& name) { impl_->removeObstacle(name); }
 void World::addMovingObstacle(const MovingObstacleConfig& obstacle) { impl_->addMovingObstacle(obstacle); }
 void World::setCommand(int robot, const Twist2D& command) { impl_->setCommand(robot, command); }
-void World::teleport(const std::string& name, const Pose2D& pose) { impl_->teleport(name, pose); }
+void World::teleport(const std::string& name, const Pose2D& pose, bool odometry_follows)
+{
+  impl_->teleport(name, pose, odometry_follows);
+}
 void World::setFaults(const std::string& name, const FaultConfig& faults) { impl_->setFaults(name, faults); }
 void World::setNoise(const NoiseConfig& noise) { impl_->setNoise(noise); }
 void World::resetPositions() { impl_->resetPositions(); }
