@@ -172,16 +172,15 @@ DwaConfig readDwaConfig(DwaParams& p, const mbot_description::RobotModel& model,
   c.vy_samples = p.getInt("vy_samples", c.vy_samples);
   c.vth_samples = p.getInt("vth_samples", c.vth_samples, "vtheta_samples");
   // dwa_local_planner's dynamic_reconfigure server raises a count below 1 to 1 (vy_samples: 0 is common).
-  for (int* samples : {&c.vx_samples, &c.vy_samples, &c.vth_samples})
-    if (*samples < 1)
-    {
-      const char* key = samples == &c.vx_samples   ? "vx_samples"
-                        : samples == &c.vy_samples ? "vy_samples"
-                                                   : "vth_samples";
-      report.notes.push_back("parameter " + p.name(key) + ": " + std::to_string(*samples) +
-                             " is raised to 1, as dwa_local_planner does");
-      *samples = 1;
-    }
+  auto atLeastOne = [&](int& samples, const std::string& key) {
+    if (samples >= 1) return;
+    report.notes.push_back("parameter " + p.name(key) + ": " + std::to_string(samples) +
+                           " is raised to 1, as dwa_local_planner does");
+    samples = 1;
+  };
+  atLeastOne(c.vx_samples, "vx_samples");
+  atLeastOne(c.vy_samples, "vy_samples");
+  atLeastOne(c.vth_samples, "vth_samples");
   c.path_distance_bias = p.getDouble("path_distance_bias", c.path_distance_bias);
   c.goal_distance_bias = p.getDouble("goal_distance_bias", c.goal_distance_bias);
   c.occdist_scale = p.getDouble("occdist_scale", c.occdist_scale);
