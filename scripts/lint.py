@@ -19,7 +19,7 @@ import sys
 from xml.sax.saxutils import escape, quoteattr
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
-SKIP_DIRS = {".git", "build", "devel", "install", "logs", "out", "docker", "__pycache__"}
+SKIP_DIRS = {".git", ".venv", "build", "devel", "install", "logs", "out", "docker", "__pycache__"}
 CPP_EXTENSIONS = (".cpp", ".h", ".hpp", ".cc")
 
 

@@ -7,6 +7,7 @@ hold the clock it waits for. So a lookup takes the newest transform and refuses 
 older than a bound, after polling for a newer one for a moment of wall time.
 """
 import functools
+import threading
 from collections import namedtuple
 
 from mbot_common.geometry import Pose2D, yaw_of
@@ -37,6 +38,95 @@ def quiet_at_shutdown(callback):
                 return None
             raise
     return wrapped
+
+
+class CachedParams(object):
+    """A node's private parameters (``~``) from rospy's parameter cache.
+
+    The node subscribes to its namespace on the master once; the master then calls the node back
+    when a parameter changes (``rosparam set``), so reading the parameters every cycle costs no
+    call to the master. rospy's cache takes updates only of keys it already holds: the known keys
+    that are not set get their defaults on the master first (as dynamic_reconfigure does), so
+    that setting one later reaches the node too.
+    """
+
+    def __init__(self, defaults):
+        import rospy
+
+        values = rospy.get_param("~", {})
+        missing = {key: value for key, value in defaults.items() if key not in values}
+        if missing:
+            merged = dict(values)
+            merged.update(missing)
+            rospy.set_param("~", merged)   # one call for all of them
+        self._key = rospy.resolve_name("~")
+        rospy.get_param_cached(self._key)
+
+    def values(self):
+        """{key: value} as the master has them now (a copy)."""
+        import rospy
+
+        return dict(rospy.get_param_cached(self._key, {}))
+
+
+class RobotTfListener(object):
+    """A tf2 Buffer filled with the poses of chosen robots only: ``/<robot>/tf_pose`` of the fleet
+    tf relay (mbot_localization's fleet_tf_relay: each robot's map -> odom -> base_footprint) and
+    ``/tf_static`` (the fixed joints). tf2_ros.TransformListener would deserialize the whole
+    fleet's /tf in Python, every follower every robot: a cost that grows with the square of the
+    fleet. Lookups in the buffer are the same as with the listener.
+
+    source "tf" makes it a plain tf2_ros.TransformListener (every robot; no relay needed)."""
+
+    def __init__(self, buffer, source="relay", topic="tf_pose"):
+        import rospy
+        import tf2_ros
+        from tf2_msgs.msg import TFMessage
+
+        if source not in ("relay", "tf"):
+            raise ValueError("tf source: expected relay or tf, got %r" % (source,))
+        self.buffer = buffer
+        self.source = source
+        self.topic = topic
+        self._msg = TFMessage
+        self._subs = {}
+        self._lock = threading.Lock()
+        self._last_update = 0.0   # [s] the clock at the newest message
+        if source == "tf":
+            self._listener = tf2_ros.TransformListener(buffer)
+        else:
+            self._static = rospy.Subscriber("/tf_static", TFMessage, self._on_static, queue_size=100)
+
+    def follow(self, robots):
+        """Receive the poses of `robots` (a set of names) and of no other robot."""
+        import rospy
+
+        if self.source == "tf":
+            return
+        with self._lock:
+            for robot in set(self._subs) - set(robots):
+                self._subs.pop(robot).unregister()
+            for robot in set(robots) - set(self._subs):
+                self._subs[robot] = rospy.Subscriber("/%s/%s" % (robot, self.topic), self._msg, self._on_tf,
+                                                     queue_size=100, tcp_nodelay=True)
+
+    def robots(self):
+        with self._lock:
+            return set(self._subs)
+
+    def _on_tf(self, msg):
+        import rospy
+
+        now = rospy.get_time()
+        if now + 1.0 < self._last_update:   # sim time jumped back (a reset): as tf2_ros does
+            self.buffer.clear()
+        self._last_update = now
+        for t in msg.transforms:
+            self.buffer.set_transform(t, "fleet_tf_relay")
+
+    def _on_static(self, msg):
+        for t in msg.transforms:
+            self.buffer.set_transform_static(t, "tf_static")
 
 
 def assignment_from_msg(msg):

@@ -2,8 +2,10 @@
 
 Every control period (sim time) it
 
-1. reads its private parameters again (every ``~param_refresh`` s), so ``rosparam set`` of a gain
-   or limit takes effect without a restart;
+1. reads its private parameters again (every ``~param_refresh`` s) from rospy's parameter cache,
+   which the master updates when one is set, so ``rosparam set`` of a gain or limit takes effect
+   without a restart and without a call to the master (only ``~rate`` needs a restart: a
+   warning says so);
 2. looks up its pose in the leader's frame from tf2 (``<leader>/base_link -> <ns>/base_link``),
    polling up to ``~pose_wait`` of wall time (0.5 s under the simulator's lockstep, where the wait
    costs no sim time) for a transform at most ``~max_pose_age`` old; a failed or stale lookup
@@ -37,16 +39,25 @@ Every control period (sim time) it
 While its robot leads (the assignment names it), the node publishes no command: the robot's
 move_base drives it. Before the first assignment, and while the fleet is IDLE, ABORTED or paused,
 it holds the robot still (zero commands, so the simulator's lockstep keeps waiting for it).
+
+Threads: rospy runs each subscription's callback and the timer in threads of their own. The
+node's state (assignment, trails, the leader's pose, the scan) is guarded by one lock, which a
+cycle holds from start to end, so an assignment never changes under a running cycle. A cycle that
+fails is logged with its traceback, holds the robot still and counts as a failure; the next
+cycle runs as usual (rospy's Timer would end for good on an exception).
 """
 import math
+import threading
 import time
+import traceback
 
 import rospy
 
 from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, detour,
                                         energy_rate, make_control_law, safety_filter, scan_points, way_blocked)
-from mbot_follower.fleet_io import StalePose, assignment_from_msg, lookup_pose, quiet_at_shutdown
+from mbot_follower.fleet_io import (CachedParams, RobotTfListener, StalePose, assignment_from_msg, lookup_pose,
+                                    quiet_at_shutdown)
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.merge import merge_target, robot_ahead
 from mbot_follower.trail import Trail, path_pose, path_slot
@@ -56,6 +67,8 @@ NODE_PARAMS = {
     "rate": 20.0,             # control frequency [Hz sim time]
     "max_pose_age": 0.1,      # oldest tf pose the controller acts on [s]
     "pose_wait": 0.1,         # how long to poll for a current pose before holding still [s wall]
+    "max_scan_age": 0.3,      # an older laser scan stops the robot: the safety layer is blind [s]
+    "tf_source": "relay",     # relay: only the robots it needs (fleet_tf_relay); tf: all of /tf
     "controller": "slot_tracking",  # control law: slot_tracking or consensus
     "param_refresh": 0.5,     # how often the private parameters are read again [s sim time]
     "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
@@ -68,6 +81,8 @@ NODE_PARAMS = {
     "merge_lane": 0.7,        # a column follower waits this far beside the path for its turn [m]
     "merge_gap": 0.6,         # ... then slides in behind the robot of the slot ahead, this far from it [m]
 }
+#: Parameters that take effect only at start (the control timer's period).
+RESTART_PARAMS = ("rate", "tf_source")
 HOLD_STATES = ("IDLE", "ABORTED")
 
 
@@ -86,22 +101,43 @@ class FollowerController(object):
         self.robot = rospy.get_namespace().strip("/")
         if not self.robot:
             raise ValueError("follower_controller must run in a robot's namespace (ns=\"follower_1\")")
+        self._init_state()
+        self._param_cache = CachedParams(dict(NODE_PARAMS, **vars(ControllerConfig())))
+        self._read_params(self._param_cache.values(), startup=True)
+        self.law = make_control_law(self.params["controller"])
+
+        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
+        self._tf = RobotTfListener(self.tf_buffer, self.params["tf_source"])
+        self._tf.follow({self.robot})
+        self.cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=1)
+        self.power_pub = rospy.Publisher("power", Float64, queue_size=1)
+        self.state_pub = rospy.Publisher("~state", FollowerState, queue_size=10)
+        rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=1)
+        rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
+        rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1)
+        rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
+        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
+        rospy.loginfo("%s: follower controller (%s) ready", rospy.get_name(), self.params["controller"])
+
+    def _init_state(self):
+        """The node's state before any message (no ROS calls: unit tests build the node so)."""
+        self.lock = threading.Lock()
+        self._tf = None                    # RobotTfListener (None in unit tests: the buffer is filled there)
         self.params = dict(NODE_PARAMS)
+        self.law = make_control_law(self.params["controller"])
         self.config = ControllerConfig()
         self._config_keys = set(vars(ControllerConfig()))
         self._warned_keys = set()
-        self._read_params(startup=True)
-        self.law = make_control_law(self.params["controller"])
         self.filter = CommandFilter(self.config)
         self.give_way = GiveWay()
         self._held = False
         self._detour_side = 1              # the side of the last way round an obstacle (+1 left)
-
         self.assignment = None
         self.fleet_state = "IDLE"
         self.paused = False
         self.scan = None
         self.free_space = None
+        self._map_msg = None               # kept to apply a new ~map_clearance
         self.trail = Trail()               # the leader's path, for a blocked slot (trail mode)
         self.path = Trail()                # the leader's path since the assignment (path slots)
         self._path_pending = False         # start self.path at the leader's next pose
@@ -114,29 +150,17 @@ class FollowerController(object):
         self._last_param_read = None
         self.lookups = 0
         self.lookup_failures = 0
-
-        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
-        self._tf_listener = tf2_ros.TransformListener(self.tf_buffer)
-        self.cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=1)
-        self.power_pub = rospy.Publisher("power", Float64, queue_size=1)
-        self.state_pub = rospy.Publisher("~state", FollowerState, queue_size=10)
-        rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=1)
-        rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
-        rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1)
-        rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
-        self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
-        rospy.loginfo("%s: follower controller (%s) ready", rospy.get_name(), self.params["controller"])
+        self.cycle_failures = 0
 
     # --- parameters ---------------------------------------------------------------------------
 
-    def _read_params(self, startup=False):
-        """Read every private parameter: node settings and the control law's gains and limits.
-        A bad value is refused with an error naming it; the previous value stays."""
-        values = rospy.get_param("~", {})
+    def _read_params(self, values, startup=False):
+        """Apply the private parameters `values`: node settings and the control law's gains and
+        limits. A bad value is refused with an error naming it; the previous value stays. A
+        changed ~rate is a warning: it takes effect at the next start."""
         for key, value in values.items():
             if key in NODE_PARAMS:
-                if startup:
-                    self.params[key] = type(NODE_PARAMS[key])(value)
+                self._apply_node_param(key, value, startup)
             elif key in self._config_keys:
                 try:
                     self.config.update({key: value})
@@ -152,10 +176,48 @@ class FollowerController(object):
                     raise ValueError(message)
                 rospy.logerr(message)
 
+    def _apply_node_param(self, key, value, startup):
+        kind = type(NODE_PARAMS[key])
+        try:
+            value = kind(value)
+        except (TypeError, ValueError):
+            if startup:
+                raise ValueError("%s: parameter ~%s: expected a %s, got %r" % (
+                    rospy.get_name(), key, kind.__name__, value))
+            rospy.logerr_throttle(5.0, "%s: parameter ~%s refused: expected a %s, got %r" % (
+                rospy.get_name(), key, kind.__name__, value))
+            return
+        if value == self.params[key] or startup:
+            self.params[key] = value
+            return
+        if key in RESTART_PARAMS:
+            if key not in self._warned_keys:
+                self._warned_keys.add(key)
+                rospy.logwarn("%s: ~%s changed to %r: it takes effect when the node restarts (running at %r)" % (
+                    rospy.get_name(), key, value, self.params[key]))
+            return
+        if key == "controller":
+            try:
+                self.law = make_control_law(value)
+            except ValueError as error:
+                rospy.logerr_throttle(5.0, "%s: parameter ~controller refused: %s" % (rospy.get_name(), error))
+                return
+        self.params[key] = value
+        if key == "map_clearance" and self._map_msg is not None:
+            self.free_space = FreeSpace.from_grid_msg(self._map_msg, value)
+        rospy.loginfo("%s: ~%s is now %r" % (rospy.get_name(), key, value))
+
     # --- inputs -------------------------------------------------------------------------------
 
     def _on_assignment(self, msg):
-        self.assignment = assignment_from_msg(msg)
+        self._on_assignment_data(assignment_from_msg(msg))
+
+    def _on_assignment_data(self, assignment):
+        with self.lock:
+            self._take_assignment(assignment)
+
+    def _take_assignment(self, assignment):
+        self.assignment = assignment
         reference = self.assignment.follows.get(self.robot) or self.assignment.leader
         if self._reference != reference:
             self._reference = reference
@@ -171,31 +233,53 @@ class FollowerController(object):
             self._leader_sub_name = source
             self.leader_twist = Twist2D(0.0, 0.0, 0.0)
             self._leader_odom_sub = rospy.Subscriber(
-                "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, queue_size=1)
+                "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, source, queue_size=1)
 
     def _on_status(self, msg):
-        self.fleet_state = msg.state
-        self.paused = msg.paused
+        with self.lock:
+            self.fleet_state = msg.state
+            self.paused = msg.paused
 
     def _on_scan(self, msg):
-        self.scan = msg
+        with self.lock:
+            self.scan = msg
 
     def _on_map(self, msg):
-        self.free_space = FreeSpace.from_grid_msg(msg, self.params["map_clearance"])
+        free_space = FreeSpace.from_grid_msg(msg, self.params["map_clearance"])  # slow: outside the lock
+        with self.lock:
+            self._map_msg = msg
+            self.free_space = free_space
 
-    def _on_leader_odom(self, msg):
+    def _on_leader_odom(self, msg, source):
         t = msg.twist.twist
-        self.leader_twist = Twist2D(t.linear.x, t.linear.y, t.angular.z)
+        with self.lock:
+            if source == self._leader_sub_name:   # not a message of a robot it no longer tracks
+                self.leader_twist = Twist2D(t.linear.x, t.linear.y, t.angular.z)
 
     # --- the control cycle --------------------------------------------------------------------
 
     def _cycle(self, _event):
+        """One control period: the step under the node's lock; a failure is logged, holds the
+        robot still and the next period runs as usual."""
+        with self.lock:
+            try:
+                self._step(rospy.Time.now())
+            except rospy.ROSException:
+                raise   # shutting down (quiet_at_shutdown)
+            except Exception:
+                self.cycle_failures += 1
+                rospy.logerr_throttle(5.0, "%s: control cycle failed (%d so far), holding still:\n%s" % (
+                    rospy.get_name(), self.cycle_failures, traceback.format_exc()))
+                self._hold()
+
+    def _step(self, now):
         started = time.time()
-        now = rospy.Time.now()
         if self._last_param_read is None or (now - self._last_param_read).to_sec() >= self.params["param_refresh"]:
-            self._read_params()
+            self._read_params(self._param_cache.values())
             self._last_param_read = now
         a = self.assignment
+        if self._tf is not None:
+            self._tf.follow(self._robots_needed(a))
         if a is None or self.robot not in a.slots:
             # Not (yet) in the formation: stand still. The command also tells the simulator's
             # lockstep to wait for this node, so sim time cannot run away from the fleet.
@@ -246,16 +330,25 @@ class FollowerController(object):
         twist = frame_twist if mode in ("slot", "merge", "detour") else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
-        if self.scan is not None:
-            scan = (self.scan.ranges, self.scan.angle_min, self.scan.angle_increment)
-            away = self.give_way.step(now.to_sec(), self._held, *scan, rank=self._rank(a, slot), config=self.config)
-            if away is not None:
-                cmd, mode = away, "give_way"
-            # The safety layer has the last word: smoothing must not carry the robot on into something.
-            cmd, self._held = safety_filter(cmd, *scan, config=self.config)
-            if self._held:
-                self.filter.sent(cmd)
-                mode = "safety_stop"
+        scan_age = (now - self.scan.header.stamp).to_sec() if self.scan is not None else math.inf
+        if scan_age > self.params["max_scan_age"]:
+            # The safety layer sees only through the laser: an old view of free space is none.
+            why = ("no scan yet" if self.scan is None else "newest scan is %.2f s old (limit ~max_scan_age %.2f s)"
+                   % (scan_age, self.params["max_scan_age"]))
+            rospy.logwarn_throttle(2.0, "%s: %s on %s: holding still" % (
+                rospy.get_name(), why, rospy.resolve_name("scan")))
+            self._hold()
+            self._publish_state(now, "no_scan", started, stamp, (slot[0] - pose.x, slot[1] - pose.y), -pose.theta)
+            return
+        scan = (self.scan.ranges, self.scan.angle_min, self.scan.angle_increment)
+        away = self.give_way.step(now.to_sec(), self._held, *scan, rank=self._rank(a, slot), config=self.config)
+        if away is not None:
+            cmd, mode = away, "give_way"
+        # The safety layer has the last word: smoothing must not carry the robot on into something.
+        cmd, self._held = safety_filter(cmd, *scan, config=self.config)
+        if self._held:
+            self.filter.sent(cmd)
+            mode = "safety_stop"
         self._send(cmd)
         self._was_driving = True
         err = (slot[0] - pose.x, slot[1] - pose.y)
@@ -318,6 +411,20 @@ class FollowerController(object):
             if not self.free_space.is_free(*transform_point(frame, *goal)):
                 return slot, False
         return goal, merging
+
+    def _robots_needed(self, a):
+        """The robots whose poses this cycle may look up: itself, the robot it follows, the
+        leader (its trail), the robot ahead on a column's path (merging) and, for consensus,
+        every member."""
+        if a is None or self.robot not in a.slots or a.leader == self.robot:
+            return {self.robot}
+        needed = {self.robot, a.leader, a.follows.get(self.robot) or a.leader}
+        ahead = robot_ahead(a.slots, self.robot)
+        if a.along_path and ahead is not None:
+            needed.add(ahead)
+        if self.params["controller"] == "consensus":
+            needed.update(a.slots)
+        return needed & (set(a.slots) | {self.robot})
 
     def _rank(self, a, slot):
         """How many follower slots lie farther from the leader than this robot's (GiveWay)."""

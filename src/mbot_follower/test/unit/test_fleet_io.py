@@ -90,8 +90,9 @@ def test_the_follower_holds_still_and_counts_a_failure_on_an_old_pose(monkeypatc
     from mbot_follower.fleet_io import Assignment
 
     f = follower_node.FollowerController.__new__(follower_node.FollowerController)
+    f._init_state()
     f.robot, f.fleet_state, f.paused = "follower_1", "NAVIGATING", False
-    f.params = {"max_pose_age": 0.1, "pose_wait": 0.0, "param_refresh": 1e9}
+    f.params.update({"max_pose_age": 0.1, "pose_wait": 0.0, "param_refresh": 1e9})
     f._last_param_read = rospy.Time.from_sec(10.0)
     f.assignment = Assignment("leader", "line", 1.5, {"leader": (0.0, 0.0), "follower_1": (0.0, -1.5)}, {})
     f.tf_buffer = _buffer_with(_transform("map", "leader/base_link", 10.0),
@@ -105,3 +106,48 @@ def test_the_follower_holds_still_and_counts_a_failure_on_an_old_pose(monkeypatc
     f._cycle(None)
     assert states == ["no_pose"] and (f.lookups, f.lookup_failures) == (1, 1)
     assert sent and all((c.vx, c.vy, c.wz) == (0.0, 0.0, 0.0) for c in sent)
+
+
+# --- RobotTfListener: the poses of the robots a node needs, from the fleet tf relay -------------
+
+class _Subscriptions(object):
+    """rospy.Subscriber stand-in: which topics are subscribed now."""
+
+    def __init__(self):
+        self.topics = {}
+
+    def __call__(self, topic, msg_class, callback, *args, **kwargs):
+        sub = self
+
+        class Sub(object):
+            def unregister(self):
+                del sub.topics[topic]
+        self.topics[topic] = callback
+        return Sub()
+
+
+def test_the_robot_tf_listener_subscribes_only_the_robots_it_follows_and_lookups_see_them(monkeypatch):
+    import tf2_ros
+    from tf2_msgs.msg import TFMessage
+
+    subs = _Subscriptions()
+    monkeypatch.setattr(rospy, "Subscriber", subs)
+    monkeypatch.setattr(rospy, "get_time", lambda: 10.0)
+    buffer = tf2_ros.Buffer(debug=False)
+    listener = fleet_io.RobotTfListener(buffer)
+    listener.follow({"leader", "follower_1"})
+    assert set(subs.topics) == {"/tf_static", "/leader/tf_pose", "/follower_1/tf_pose"}
+    listener.follow({"leader", "follower_2"})      # a new assignment: follower_1 is no longer needed
+    assert set(subs.topics) == {"/tf_static", "/leader/tf_pose", "/follower_2/tf_pose"}
+    assert listener.robots() == {"leader", "follower_2"}
+
+    subs.topics["/leader/tf_pose"](TFMessage([_transform("map", "leader/odom", 10.0, x=1.0),
+                                              _transform("leader/odom", "leader/base_footprint", 10.0, x=2.0)]))
+    subs.topics["/tf_static"](TFMessage([_transform("leader/base_footprint", "leader/base_link", 0.0)]))
+    pose, stamp = fleet_io.lookup_pose(buffer, "map", "leader/base_link", rospy.Time.from_sec(10.05), 0.1)
+    assert pose.x == pytest.approx(3.0) and stamp.to_sec() == pytest.approx(10.0)
+
+
+def test_the_robot_tf_listener_refuses_an_unknown_source():
+    with pytest.raises(ValueError, match="expected relay or tf"):
+        fleet_io.RobotTfListener(None, source="all")
