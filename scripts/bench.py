@@ -16,7 +16,13 @@
                                       convergence, straight and route slot error, switch time,
                                       recovery after a loss, contacts, controller cycle time
                                       (mbot_follower/formation_bench.py)
-    scripts/bench all [--json FILE]   sim and nav (the formation benchmark takes long: run it alone)
+    scripts/bench fleet [--json FILE] [--sizes 3,10,20,40] [--modes formation,navigation]
+                                      what the fleet around the simulator costs: real-time
+                                      factor, CPU s per robot per sim s and each process kind's
+                                      share, for a triangle driving 6 m in `trio` and for the
+                                      same robots with a move_base goal each
+                                      (mbot_bringup/fleet_bench.py)
+    scripts/bench all [--json FILE]   sim and nav (the formation and fleet benchmarks take long: run them alone)
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
 Every program runs pinned to one core (taskset) so figures compare with single-threaded peers.
@@ -171,6 +177,14 @@ def bench_formation(seeds, sizes):
     return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
 
 
+def bench_fleet(sizes, modes):
+    """The whole fleet, many processes (not pinned); one run per size and mode."""
+    from mbot_bringup import fleet_bench
+
+    return fleet_bench.bench_fleet([int(n) for n in sizes.split(",")], os.path.join(ROOT, "out", "bench_fleet"),
+                                   modes.split(","))
+
+
 def print_table(result):
     if "rtf" in result:
         print("\nSimulator (one core, as fast as possible, 360-beam 10 Hz lasers, 100 Hz physics)")
@@ -191,6 +205,10 @@ def print_table(result):
         d, sh = result["dwa_ms"], result["dwa_ms_shipped"]
         print("\nDWA cycle (thread CPU time): defaults p50 %.2f ms, p99 %.2f ms; nav_dwa.yaml p50 %.2f ms, p99 %.2f ms"
               " (wall p99 %.2f ms)" % (d["p50"], d["p99"], sh["p50"], sh["p99"], sh["wall_p99"]))
+    if "fleet_scale" in result or "fleet_scale_navigation" in result:
+        from mbot_bringup import fleet_bench
+
+        print(fleet_bench.table(result))
     if "formation" in result:
         print("\nFormation (worst over seeds; targets: straight <= 0.05 m, route <= 0.15 m, converge <= 10 s,"
               " switch <= 6 s, DEGRADED <= 2 s, re-converged <= 10 s, 0 contacts)")
@@ -221,7 +239,7 @@ def print_table(result):
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="scripts/bench", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=["sim", "nav", "formation", "all"])
+    parser.add_argument("what", choices=["sim", "nav", "formation", "fleet", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
     parser.add_argument("--trial-rtf", type=float, default=0.0,
@@ -230,7 +248,8 @@ def main(argv=None):
                         help="goals of the fleet trial (3 robots, person, particle filter; 0: skip)")
     parser.add_argument("--sim-runs", type=int, default=3, help="sim: runs per fleet size (median and range)")
     parser.add_argument("--seeds", type=int, default=10, help="formation: seeds per fleet size")
-    parser.add_argument("--sizes", default="3,5,10", help="formation: fleet sizes")
+    parser.add_argument("--sizes", help="formation: fleet sizes (default 3,5,10); fleet: (default 3,10,20,40)")
+    parser.add_argument("--modes", default="formation,navigation", help="fleet: formation, navigation or both")
     args = parser.parse_args(argv)
     if args.sim_runs < 1:
         parser.error("--sim-runs must be >= 1")
@@ -240,7 +259,11 @@ def main(argv=None):
     if args.what in ("nav", "all"):
         result.update(bench_nav(args.trial_runs, args.trial_rtf, args.fleet_runs))
     if args.what == "formation":
-        result.update(bench_formation(args.seeds, args.sizes))
+        result.update(bench_formation(args.seeds, args.sizes or "3,5,10"))
+    if args.what == "fleet":
+        if not set(args.modes.split(",")) <= {"formation", "navigation"}:
+            parser.error("--modes: formation, navigation or both (comma-separated)")
+        result.update(bench_fleet(args.sizes or "3,10,20,40", args.modes))
     result["machine"] = machine()
     print_table(result)
     if args.json:

@@ -175,17 +175,21 @@ def write_run_world(world, out, count=None, config=None):
     return names
 
 
+#: The most robots a run may have (the fleet benchmark's largest size is 40).
+MAX_ROBOTS = 60
+
+
 def parse_count(text):
-    """--robots: '' (the world's robots) or an integer 1..20."""
+    """--robots: '' (the world's robots) or an integer 1..MAX_ROBOTS."""
     if text == "":
         return None
     try:
         count = int(text)
     except ValueError:
         count = None
-    if count is None or not 1 <= count <= 20:
-        raise ConfigError("robots: expected a number of robots from 1 to 20 (or nothing: the world's), "
-                          "got \"%s\"" % text)
+    if count is None or not 1 <= count <= MAX_ROBOTS:
+        raise ConfigError("robots: expected a number of robots from 1 to %d (or nothing: the world's), "
+                          "got \"%s\"" % (MAX_ROBOTS, text))
     return count
 
 

@@ -24,6 +24,7 @@ import os
 
 from mbot_common.strict_yaml import ConfigError, Reader, load_yaml
 from mbot_common.world import FAULT_KEYS, Faults, check_faults, check_name
+from mbot_bringup.fleet_world import MAX_ROBOTS
 
 MODES = ("formation", "dispatch")
 LOCALIZATIONS = ("fake", "pf")
@@ -331,8 +332,8 @@ def load_scenario(path):
     s.name = os.path.basename(path)[:-len(".yaml")] if path.endswith(".yaml") else os.path.basename(path)
     s.description = r.optional("description", str, "")
     s.world = r.required("world", str, what="a world name (maps/NAME.world.yaml) or a path", check=lambda v: v != "")
-    s.robots = r.optional("robots", int, None, what="an integer from 1 to 20 (the number of robots)",
-                          check=lambda v: 1 <= v <= 20)
+    s.robots = r.optional("robots", int, None, what="an integer from 1 to %d (the number of robots)" % MAX_ROBOTS,
+                          check=lambda v: 1 <= v <= MAX_ROBOTS)
     s.mode = r.optional("mode", str, "formation", what=" or ".join(MODES), check=lambda v: v in MODES)
     formation_keys = ("leader", "formation", "spacing", "topology", "controller", "leader_max_vel")
     if s.mode == "formation":

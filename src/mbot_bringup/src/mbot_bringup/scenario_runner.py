@@ -750,6 +750,7 @@ def run(args):
             return 3
         say("fleet up; playing %d steps (time limit %g s sim)" % (len(scenario.timeline), scenario.time_limit))
         facts = player.play(alive=launch.alive)
+        say("scenario over at %.1f s sim: stopping the fleet" % facts["end_s"])
         if screenshots is not None:
             screenshots.close()
     except KeyboardInterrupt:

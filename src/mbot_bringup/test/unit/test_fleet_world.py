@@ -82,7 +82,7 @@ def test_the_command_line_prints_the_path_and_names_a_bad_count(tmp_path, capsys
     assert main(["--names", out]) == 0
     assert yaml.safe_load(capsys.readouterr().out) == ["leader", "follower_1", "follower_2", "robot_3"]
     assert main(["--world", "trio", "--robots", "many", "--out", out]) == 1
-    assert 'robots: expected a number of robots from 1 to 20' in capsys.readouterr().err
+    assert 'robots: expected a number of robots from 1 to 60' in capsys.readouterr().err
     assert main(["--world", "trio", "--mode", "swarm", "--out", out]) == 1
     assert 'mode: expected formation or dispatch, got "swarm"' in capsys.readouterr().err
     assert parse_count("") is None and parse_count("7") == 7
