@@ -675,6 +675,7 @@ class RunWriter(object):
         self.written[name] = len(items)
 
     def write(self, run, summary):
+        """The run's new rows; metrics.json too unless `summary` is None."""
         columns = sample_columns(run.robots)
         if columns != self.columns:
             self.written.pop("metrics.csv", None)   # new columns: write it again from the start
@@ -682,6 +683,8 @@ class RunWriter(object):
         self._append("metrics.csv", columns, run.samples, lambda s: _sample_row(s, run.robots))
         self._append("events.csv", EVENT_COLUMNS, run.events, lambda e: [_cell(v) for v in e])
         self._append("controller.csv", CONTROLLER_COLUMNS, run.controller, lambda c: [_cell(v) for v in c])
+        if summary is None:
+            return
         tmp = self.path("metrics.json.tmp")
         with open(tmp, "w") as f:
             json.dump(summary, f, indent=1)

@@ -21,6 +21,7 @@ A message without a stamp (zero) counts at the time it arrives.
 """
 import math
 import threading
+import time
 
 import rospy
 from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
@@ -32,6 +33,12 @@ from mbot_common.params import read_params
 from mbot_follower.fleet_io import assignment_from_msg, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter, summarize
+
+#: The live summary (/fleet/metrics, metrics.json while the run goes) goes over the whole record,
+#: so its cost grows with the run: it is computed again only after 1 / SUMMARY_SHARE times its
+#: last CPU time has passed, so that it never takes more than this share of a core. The final
+#: summary (at shutdown) is always computed.
+SUMMARY_SHARE = 0.05
 
 #: Node parameters that are not MetricsConfig fields: name -> (kind, default).
 NODE_PARAMS = {
@@ -78,6 +85,7 @@ class MetricsNode(object):
         self.lock = threading.Lock()
         self.write_lock = threading.Lock()   # one writer at a time, the newest record last
         self.closed = False
+        self.summary_due = 0.0   # [s monotonic wall] when the live summary may be computed again
         self.subs = {}
         self.pub = rospy.Publisher("/fleet/metrics", FleetMetrics, queue_size=1)
         # In lockstep the simulator holds sim time until this heartbeat (the newest sample's time)
@@ -179,11 +187,24 @@ class MetricsNode(object):
 
     # --- outputs --------------------------------------------------------------------------------
 
+    def live_summary(self, run):
+        """summarize(run), or None while the last one's cost is not yet paid off (SUMMARY_SHARE)."""
+        now = time.monotonic()
+        if now < self.summary_due:
+            return None
+        started = time.thread_time()
+        summary = summarize(run)
+        self.summary_due = now + (time.thread_time() - started) / SUMMARY_SHARE
+        return summary
+
     def publish(self, _event=None):
         with self.lock:
             run = self.collector.run.snapshot()
             state = self.collector.state
-        fleet = summarize(run)["fleet"]
+        summary = self.live_summary(run)
+        if summary is None:
+            return
+        fleet = summary["fleet"]
 
         def number(key):
             return float("nan") if fleet[key] is None else fleet[key]
@@ -210,7 +231,7 @@ class MetricsNode(object):
             run = self.collector.run.snapshot()
         with self.write_lock:
             if not self.closed:   # else finish() writes (or wrote) a newer record
-                self._write(run)
+                self._write(run, self.live_summary(run))
 
     def finish(self):
         """At shutdown: the last write, then no more messages."""
@@ -220,15 +241,16 @@ class MetricsNode(object):
             self.closed = True
             run = self.collector.run.snapshot()
         with self.write_lock:
-            if self.writer is not None and self._write(run):
+            if self.writer is not None and self._write(run, summarize(run)):
                 rospy.loginfo("%s: %d samples written to %s", rospy.get_name(), len(run.samples),
                               self.writer.output_dir)
 
-    def _write(self, run):
-        """Write the record; a folder that is gone (a test removed it as the run ended) or full is
-        an error naming it, not a crash of the collector. Returns whether it was written."""
+    def _write(self, run, summary):
+        """Write the record (metrics.json only with a summary); a folder that is gone (a test
+        removed it as the run ended) or full is an error naming it, not a crash of the collector.
+        Returns whether it was written."""
         try:
-            self.writer.write(run, summarize(run))
+            self.writer.write(run, summary)
             return True
         except OSError as error:
             rospy.logerr_throttle(10.0, "%s: cannot write the record to %s: %s" % (

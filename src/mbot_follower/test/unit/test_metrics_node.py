@@ -25,6 +25,7 @@ def node(output_dir):
     n.writer = RunWriter(output_dir)
     n.lock, n.write_lock = threading.Lock(), threading.Lock()
     n.closed = False
+    n.summary_due = 0.0
     n.pub = Publisher()
     n.collector.on_assignment(0.0, wedge())
     n.collector.on_status(0.0, "NAVIGATING", "goal", [])
@@ -73,3 +74,53 @@ def test_the_record_is_written_outside_the_lock_and_a_save_after_finish_writes_n
     n.save()            # a timer that fires after finish() must not overwrite its record
     with open(os.path.join(str(tmp_path), "metrics.json")) as f:
         assert json.load(f) == written
+
+
+class Clocks(object):
+    """time.monotonic and time.thread_time for the node, moved by the test."""
+
+    def __init__(self):
+        self.wall = 100.0
+        self.cpu = 0.0
+
+    def monotonic(self):
+        return self.wall
+
+    def thread_time(self):
+        return self.cpu
+
+
+def test_the_live_summary_costs_at_most_its_share_of_a_core_and_the_final_one_is_always_made(tmp_path, monkeypatch):
+    """A long run's summary costs more every second; recomputed every second it made the
+    collector's cost grow with the square of the run. Now it waits 1 / SUMMARY_SHARE times its
+    own CPU time; the files still get their new rows, and finish() always summarizes."""
+    n = node(str(tmp_path))
+    clocks = Clocks()
+    monkeypatch.setattr(metrics_node, "time", clocks)
+    monkeypatch.setattr(metrics_node.rospy.Time, "now", staticmethod(lambda: metrics_node.rospy.Time(2, 0)))
+    real = metrics_node.summarize
+    made = []
+
+    def costly(run):           # each summary costs 0.1 s CPU: the next one is due 2 s later
+        made.append(len(run.samples))
+        clocks.cpu += 0.1
+        return real(run)
+
+    monkeypatch.setattr(metrics_node, "summarize", costly)
+    n.publish()
+    assert len(made) == 1 and len(n.pub.sent) == 1
+    clocks.wall += 1.0
+    n.publish()                # not due: nothing computed, nothing published
+    n.save()                   # the rows go out, metrics.json waits for a summary
+    assert len(made) == 1 and len(n.pub.sent) == 1
+    assert not os.path.exists(os.path.join(str(tmp_path), "metrics.json"))
+    with open(os.path.join(str(tmp_path), "metrics.csv")) as f:
+        assert len(f.readlines()) > 10
+    clocks.wall += 1.0 + 1e-6
+    n.publish()
+    assert len(made) == 2 and len(n.pub.sent) == 2
+    feed(n, 2.0, 3.0)
+    n.finish()                 # not due, but the final record is always summarized
+    assert len(made) == 3
+    with open(os.path.join(str(tmp_path), "metrics.json")) as f:
+        assert json.load(f)["samples"] == made[-1] > made[0]   # the whole record, to its end
