@@ -5,7 +5,9 @@ It publishes /clock, /<robot>/base_pose_ground_truth and /<robot>/odom with equa
 both orders, and with the robot and its odometry drift moving every step, so that pairing the
 wrong samples shows), then checks for every stamp t that tf map -> <robot>/odom at
 t + transform_tolerance equals T_map_base(gt, t) * inverse(T_odom_base(odom, t)) within 1e-6,
-and that amcl_pose is the ground truth.
+and that amcl_pose is the ground truth. With ~tf_publish_rate > 0 the node publishes the
+transform of every stamp at least 1/rate after the last one it published (on this 50 Hz grid at
+10 Hz: every 5th), and amcl_pose still for every stamp.
 """
 import unittest
 
@@ -58,6 +60,7 @@ class FakeLocalizationTest(unittest.TestCase):
     def setUp(self):
         self.robot = rospy.get_param("~robot")
         self.tolerance_ns = int(round(rospy.get_param("~transform_tolerance") * 1e9))
+        self.every = rospy.get_param("~every")   # the node publishes tf for every this many steps
         self.clock_pub = rospy.Publisher("/clock", Clock, queue_size=10)
         self.odom_pub = rospy.Publisher("/%s/odom" % self.robot, Odometry, queue_size=100)
         self.truth_pub = rospy.Publisher("/%s/base_pose_ground_truth" % self.robot, Odometry,
@@ -67,7 +70,11 @@ class FakeLocalizationTest(unittest.TestCase):
         self.poses = []
         self.pose_sub = rospy.Subscriber("/%s/amcl_pose" % self.robot, PoseWithCovarianceStamped,
                                          self.poses.append)
-        self.tf_probe = rospy.Subscriber("/tf", TFMessage, lambda _: None)  # shares the listener's link
+        self.tf_stamps = []
+        self.tf_probe = rospy.Subscriber("/tf", TFMessage, self.on_tf)  # shares the listener's link
+
+    def on_tf(self, msg):
+        self.tf_stamps += [t.header.stamp for t in msg.transforms if t.child_frame_id == self.robot + "/odom"]
 
     def publish(self, publisher, k, frame, child, pose):
         msg = Odometry()
@@ -102,7 +109,11 @@ class FakeLocalizationTest(unittest.TestCase):
             wait_for(lambda: len(self.poses) > k, 30, "amcl_pose of step %d" % k)
 
         worst = 0.0
-        for k in range(STEPS):
+        published = [k for k in range(STEPS) if k % self.every == 0]
+        expected_stamps = [stamp(START_NS + k * STEP_NS + self.tolerance_ns) for k in published]
+        wait_for(lambda: len(self.tf_stamps) >= len(published), 30, "%d tf samples" % len(published))
+        self.assertEqual(self.tf_stamps, expected_stamps)
+        for k in published:
             when = stamp(START_NS + k * STEP_NS + self.tolerance_ns)
             wait_for(lambda: self.buffer.can_transform("map", odom_frame, when), 30,
                      "tf map -> %s at step %d" % (odom_frame, k))
@@ -118,7 +129,7 @@ class FakeLocalizationTest(unittest.TestCase):
             error = np.abs(got - expected).max()
             worst = max(worst, error)
             self.assertLess(error, 1e-6, "step %d: got\n%s\nexpected\n%s" % (k, got, expected))
-        rospy.loginfo("fake_localization: %d tf samples, worst matrix error %.2e", STEPS, worst)
+        rospy.loginfo("fake_localization: %d tf samples, worst matrix error %.2e", len(published), worst)
 
         wait_for(lambda: len(self.poses) >= STEPS, 30, "%d amcl_pose messages" % STEPS)
         self.assertEqual(len(self.poses), STEPS)
@@ -134,4 +145,4 @@ class FakeLocalizationTest(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("test_fake_localization")
-    rostest.rosrun(PKG, "fake_localization_tf", FakeLocalizationTest)
+    rostest.rosrun(PKG, rospy.get_param("~test_name", "fake_localization_tf"), FakeLocalizationTest)

@@ -467,3 +467,47 @@ def test_give_way_of_an_omni_robot_moves_straight_away():
     g.step(0.0, True, ranges, -math.pi, 2 * math.pi / n, rank=0, config=config)
     cmd = g.step(1.1, True, ranges, -math.pi, 2 * math.pi / n, rank=0, config=config)
     assert cmd.vx == pytest.approx(0.0, abs=1e-9) and cmd.vy == pytest.approx(-config.yield_speed)
+
+
+def _reference_checks(ranges, angle_min, inc, config):
+    """The laser checks beam by beam, as written before they were vectorised (numpy)."""
+    import math as m
+
+    from mbot_common.geometry import normalize_angle
+    stop = lane = False
+    for i, r in enumerate(ranges):
+        a = normalize_angle(angle_min + i * inc)
+        if abs(a) <= config.safety_half_angle and not m.isnan(r) and \
+                (r == -m.inf or (m.isfinite(r) and r < config.safety_distance)):
+            stop = True
+        if not m.isnan(r) and abs(a) <= m.pi / 2 and (r == -m.inf or (
+                m.isfinite(r) and 0.0 < r * m.cos(a) < config.safety_near_distance
+                and abs(r * m.sin(a)) < config.safety_lane_half_width)):
+            lane = True
+    points = [(r * m.cos(angle_min + i * inc), r * m.sin(angle_min + i * inc))
+              for i, r in enumerate(ranges) if 0.12 <= r <= 2.35]
+    return stop, lane, points
+
+
+def test_the_vectorised_laser_checks_agree_with_the_beam_by_beam_rules_on_random_scans():
+    import random
+
+    from mbot_follower.control_laws import ControllerConfig, lane_blocked, safety_stop, scan_points
+    rng = random.Random(7)
+    config = ControllerConfig()
+    agreed = {"stop": 0, "lane": 0}
+    for _ in range(300):
+        n = rng.choice([90, 360, 361])
+        angle_min = rng.uniform(-4.0, 1.0)
+        inc = 2 * math.pi / n
+        ranges = [rng.choice([math.inf, -math.inf, math.nan, rng.uniform(0.0, 1.2), rng.uniform(0.0, 9.0)])
+                  if rng.random() < 0.02 else rng.uniform(0.3, 9.0) for _ in range(n)]
+        stop, lane, points = _reference_checks(ranges, angle_min, inc, config)
+        assert safety_stop(ranges, angle_min, inc, config.safety_distance, config.safety_half_angle) == stop
+        assert lane_blocked(ranges, angle_min, inc, config.safety_near_distance, config.safety_lane_half_width) == lane
+        got = scan_points(ranges, angle_min, inc, 0.12, 2.35)
+        assert len(got) == len(points)
+        assert all(abs(a[0] - b[0]) < 1e-9 and abs(a[1] - b[1]) < 1e-9 for a, b in zip(got, points))
+        agreed["stop"] += stop
+        agreed["lane"] += lane
+    assert 10 < agreed["stop"] < 290 and 5 < agreed["lane"] < 295   # both answers were exercised
