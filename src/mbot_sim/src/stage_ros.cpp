@@ -299,6 +299,9 @@ void StageRos::run()
         pacing_reset_ = true;  // too slow for this factor: go on from here, no catch-up burst
     }
   }
+  if (params_.lockstep)  // for benchmarks: what the waits cost over the whole run
+    ROS_INFO("stage_node: lockstep: %ld boundaries, %ld wall timeouts (%g s wall each)", boundary_count_,
+             lockstep_timeouts_total_, params_.lockstep_wall_timeout);
 }
 
 }  // namespace mbot_sim

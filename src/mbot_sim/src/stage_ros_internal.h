@@ -11,6 +11,16 @@
 
 namespace mbot_sim
 {
+/// Lockstep: zero cmd_vels in a row that must find the robot at rest, each soon after the command
+/// before, before its controller counts as holding it still (and is waited for like a driving one).
+/// move_base sends one or two when a goal ends or is cancelled (the stop, then its idle cycle) and
+/// then nothing; a follower controller that holds its robot still sends one every cycle.
+constexpr int kHoldingZeros = 3;
+/// [s wall] "soon" for those zeros while sim time runs free (nothing holds it, so many periods of
+/// sim time pass between two cycles of a controller); generous for a starved controller, short
+/// beside move_base's goals.
+constexpr double kHoldingWallGap = 0.5;
+
 inline geometry_msgs::Quaternion yawToQuaternion(double yaw)
 {
   const std::array<double, 4> xyzw = mbot_common::quaternionFromYaw(yaw);

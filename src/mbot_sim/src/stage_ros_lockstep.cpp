@@ -6,6 +6,8 @@
  */
 #include "mbot_sim/stage_ros.h"
 
+#include "stage_ros_internal.h"
+
 #include <ros/callback_queue.h>
 
 #include <algorithm>
@@ -14,6 +16,12 @@
 
 namespace mbot_sim
 {
+/// Lockstep: the robot's controller has stopped commanding: its last cmd_vel was a stop (all zeros)
+/// and it is not holding the robot still (fewer than kHoldingZeros zeros in a row found it at rest,
+/// see onCmdVel()). The robot needs no controller to come to rest and stay there, so sim time does
+/// not wait for it.
+bool StageRos::stopped(const RobotIo& io) { return io.cmd_zero && io.zeros_at_rest < kHoldingZeros; }
+
 /// Lockstep: after a step, note whether /clock just reached (or crossed) a period boundary.
 void StageRos::noteBoundary()
 {
@@ -30,6 +38,9 @@ void StageRos::noteBoundary()
 /// two boundaries (any phase) answer in time, so at real-time factors the controller keeps up with
 /// it rarely waits; "one cmd_vel, one boundary" keeps sim time at most one period (+ one physics
 /// step) ahead of the controller's last cycle. Callbacks and services are served while waiting.
+/// A robot whose controller has stopped commanding (stopped(): its last cmd_vel was a stop that is
+/// not one of a holding controller's repeated zeros) is not waited for until it sends again: move_base
+/// goes silent after a goal, and waiting for its next cmd_vel cost one wall timeout per goal.
 /// Every robot whose localization publishes map -> <ns>/odom on /tf (driven or not) is also waited
 /// for until that transform is at most ~lockstep_localization_lag behind sim time: otherwise sim
 /// time runs away from a localization that cannot keep up (between goals, when no robot is driven,
@@ -54,11 +65,12 @@ bool StageRos::waitForControllers()
     return world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout;
   };
   const auto answered = [this](const RobotIo& io) { return io.cmd_unused && io.cmd_boundary >= boundary_count_ - 1; };
+  const auto commandLate = [&](const RobotIo& io) { return driven(io) && !answered(io) && !stopped(io); };
   const auto localized = [this](const RobotIo& io) {
     return io.localization_ignored || io.localization_stamp < -1e8 ||  // none seen: nothing to wait for
            localizationCurrent(io);
   };
-  const auto waitingFor = [&](const RobotIo& io) { return (driven(io) && !answered(io)) || !localized(io); };
+  const auto waitingFor = [&](const RobotIo& io) { return commandLate(io) || !localized(io); };
   const auto paced = [this](const Pacer& p) {
     return p.ignored || p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9;
   };
@@ -81,7 +93,7 @@ bool StageRos::waitForControllers()
       for (auto& io : io_)
         if (io && waitingFor(*io))
         {
-          if (driven(*io) && !answered(*io))
+          if (commandLate(*io))
           {
             late += (late.empty() ? "" : ", ") + io->name + " (no cmd_vel)";
             io->last_cmd_time = -1e9;  // not driven until its next cmd_vel
@@ -101,6 +113,7 @@ bool StageRos::waitForControllers()
           p.second.ignored = true;
         }
       ++lockstep_timeouts_;
+      ++lockstep_timeouts_total_;
       if ((wall_now - last_lockstep_warning_).toSec() >= 5.0)  // throttled: a slow controller times out often
       {
         ROS_WARN(

@@ -134,10 +134,21 @@ void StageRos::onContact(const ContactEvent& e)
 void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
 {
   if (!world_->hasRobot(robot)) return;  // removed while the message waited
+  RobotIo& io = *io_[robot];
+  const ros::WallTime wall_now = ros::WallTime::now();
+  // Lockstep: count the zeros in a row that find the robot at rest: a controller that repeats them
+  // soon after each other holds its robot still (see stopped()). "Soon" in sim time, or in wall
+  // time for sim time that runs free because nothing holds it.
+  const bool soon = world_->time() - io.last_cmd_time <= params_.lockstep_active_timeout ||
+                    (wall_now - io.last_cmd_wall).toSec() <= kHoldingWallGap;
+  io.cmd_zero = msg->linear.x == 0.0 && msg->linear.y == 0.0 && msg->angular.z == 0.0;
+  if (!io.cmd_zero || !soon) io.zeros_at_rest = 0;
+  if (io.cmd_zero && world_->atRest(robot)) ++io.zeros_at_rest;  // a zero while it brakes or is pushed: no count
   world_->setCommand(robot, Twist2D{msg->linear.x, msg->linear.y, msg->angular.z});
-  io_[robot]->last_cmd_time = world_->time();
-  io_[robot]->cmd_boundary = boundary_count_;
-  io_[robot]->cmd_unused = true;
+  io.last_cmd_time = world_->time();
+  io.last_cmd_wall = wall_now;
+  io.cmd_boundary = boundary_count_;
+  io.cmd_unused = true;
 }
 
 /// As stage_ros: a pose in the map frame; z, roll and pitch are ignored. The robot is moved at

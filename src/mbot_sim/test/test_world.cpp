@@ -341,6 +341,28 @@ TEST(TrueZeros, APushedRobotIsNotAtRestAndReportsItsMotion)
   EXPECT_TRUE(exactlyZero(rec.truth[pusher].back().twist));
 }
 
+TEST(TrueZeros, AtRestOnlyWhileTheDriveStandsStillAndNothingPushes)
+{
+  // stage_node's lockstep asks this: a zero command that finds the robot at rest is "holding".
+  World world(openMap(), WorldSettings{});
+  const int pusher = world.addRobot("pusher", diffModel(), Pose2D{0.0, 0.0, 0.0});
+  // never commanded:
+  const int pushed = world.addRobot("pushed", diffModel(), Pose2D{1.0, 0.0, 0.0});
+  EXPECT_TRUE(world.atRest(pusher));  // as placed
+  drive(world, pusher, Twist2D{0.3, 0.0, 0.0}, 0.5);
+  EXPECT_FALSE(world.atRest(pusher));  // driving
+  world.setCommand(pusher, Twist2D{});
+  world.step();
+  EXPECT_FALSE(world.atRest(pusher));  // braking from 0.3 m/s at 1 m/s^2 takes 0.3 s
+  run(world, 0.5);
+  EXPECT_TRUE(world.atRest(pusher));
+  drive(world, pusher, Twist2D{0.3, 0.0, 0.0}, 3.0);  // touches the other robot after ~2 s
+  EXPECT_FALSE(world.atRest(pushed));                 // pushed: moving although never commanded
+  run(world, 1.5);                                    // the watchdog stops the pusher
+  EXPECT_TRUE(world.atRest(pusher));
+  EXPECT_TRUE(world.atRest(pushed));
+}
+
 // ---- contacts ---------------------------------------------------------------------------------
 
 TEST(Contacts, RobotDrivenIntoAWallStopsAtItAndOneContactIsReported)

@@ -108,6 +108,9 @@ private:
     double last_cmd_time = -1e9;        ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
     long cmd_boundary = -1;             ///< boundary_count_ when the last cmd_vel arrived
     bool cmd_unused = false;            ///< lockstep: the last cmd_vel has not released a boundary yet
+    ros::WallTime last_cmd_wall;        ///< lockstep: wall time of the last cmd_vel
+    bool cmd_zero = false;              ///< lockstep: the last cmd_vel was all zeros (a stop)
+    int zeros_at_rest = 0;              ///< lockstep: zero cmd_vels in a row that found the robot at rest
     double localization_stamp = -1e9;   ///< lockstep: newest stamp of a transform to <ns>/odom [s]
     bool localization_ignored = false;  ///< lockstep: its localization timed out; not waited for
                                         ///< until it has caught up
@@ -125,6 +128,7 @@ private:
   void onTf(const tf2_msgs::TFMessage::ConstPtr& msg);
   void onHeartbeat(const std_msgs::Header::ConstPtr& msg);
   bool localizationCurrent(const RobotIo& io) const;
+  static bool stopped(const RobotIo& io);
   /// cmd_pose and cmd_pose_stamped (`topic` names which, for the log).
   void onCmdPose(int robot, const geometry_msgs::Pose& pose, const char* topic);
   bool onReset(std_srvs::Empty::Request& req, std_srvs::Empty::Response& res);
@@ -177,6 +181,7 @@ private:
   };
   std::map<std::string, Pacer> pacers_;  ///< by node name (the heartbeat's frame_id)
   long lockstep_timeouts_ = 0;           ///< wall timeouts since the last warning
+  long lockstep_timeouts_total_ = 0;     ///< wall timeouts since the start (logged at the end)
   ros::WallTime last_lockstep_warning_;
 };
 

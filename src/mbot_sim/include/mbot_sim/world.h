@@ -217,6 +217,9 @@ public:
   Pose2D groundTruth(int robot) const;  ///< true pose in the map frame
   Twist2D velocity(int robot) const;    ///< true velocity in the robot frame (exactly 0 at rest)
   Pose2D odometry(int robot) const;     ///< current odometry pose (odom frame)
+  /// @brief At rest: its drive stands still and nothing pushes it (see "true zeros"); a robot
+  ///        that brakes or is pushed is not.
+  bool atRest(int robot) const;
   const FaultConfig& faults(int robot) const;
   const NoiseConfig& noise() const;  ///< the sensor noise in force
   /// @brief True when a circle of `radius` [m] at (x, y) inside the map overlaps no wall,

@@ -134,7 +134,8 @@ struct Robot
 
   // true state after the last step
   Pose2D pose;
-  Twist2D velocity;  ///< robot frame
+  Twist2D velocity;     ///< robot frame
+  bool at_rest = true;  ///< the drive stands still and nothing pushes it (settleRobot)
 
   // odometry
   Pose2D odom;

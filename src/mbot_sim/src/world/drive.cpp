@@ -65,6 +65,7 @@ void placeBody(Robot& r, const Pose2D& pose)
   dBodySetAngularVel(r.body.get(), 0, 0, 0);
   r.pose = Pose2D{pose.x, pose.y, normalizeAngle(pose.theta)};
   r.velocity = Twist2D{};
+  r.at_rest = true;
   r.setpoint = Twist2D{};
   r.command = Twist2D{};
   r.command_time = -kInf;
@@ -115,8 +116,10 @@ void settleRobot(Robot& r)
     dBodySetLinearVel(b, 0.0, 0.0, 0.0);
     dBodySetAngularVel(b, 0.0, 0.0, 0.0);
     r.velocity = Twist2D{};
+    r.at_rest = true;
     return;
   }
+  r.at_rest = false;
   dBodySetLinearVel(b, vx, vy, 0.0);
   dBodySetAngularVel(b, 0.0, 0.0, wz);
 

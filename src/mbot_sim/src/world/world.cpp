@@ -576,6 +576,7 @@ const std::string& World::robotName(int robot) const { return impl_->robotById(r
 const RobotModel& World::robotModel(int robot) const { return impl_->robotById(robot).model; }
 Pose2D World::groundTruth(int robot) const { return impl_->robotById(robot).pose; }
 Twist2D World::velocity(int robot) const { return impl_->robotById(robot).velocity; }
+bool World::atRest(int robot) const { return impl_->robotById(robot).at_rest; }
 Pose2D World::odometry(int robot) const { return impl_->robotById(robot).odom; }
 const FaultConfig& World::faults(int robot) const { return impl_->robotById(robot).faults; }
 const NoiseConfig& World::noise() const { return impl_->settings.noise; }
