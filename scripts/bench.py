@@ -19,7 +19,7 @@
     scripts/bench fleet [--json FILE] [--sizes 3,10,20,40] [--modes formation,navigation]
                                       what the fleet around the simulator costs: real-time
                                       factor, CPU s per robot per sim s and each process kind's
-                                      share, for a triangle driving 6 m in `trio` and for the
+                                      share, for a triangle driving 6 m in `field` and for the
                                       same robots with a move_base goal each
                                       (mbot_bringup/fleet_bench.py)
     scripts/bench all [--json FILE]   sim and nav (the formation and fleet benchmarks take long: run them alone)

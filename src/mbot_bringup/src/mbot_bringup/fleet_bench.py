@@ -1,7 +1,9 @@
 """What the fleet costs per robot: ``scripts/bench fleet [--sizes 3,10,20,40] [--json FILE]``.
 
 For each fleet size it runs two scenarios with the scenario runner (real_time_factor 0 with
-lockstep, no rviz, no rosbag), in the ``trio`` room:
+lockstep, no rviz, no rosbag), in the empty 40 x 40 m ``field`` (the trio's three robots, the
+others placed near the leader; in the 20 x 20 m ``trio`` room a triangle of 20 has slots in the
+wall):
 
 - formation: a triangle, 1.2 m spacing, driving 6 m east;
 - navigation: the same robots with a goal each (dispatch), no formation nodes.
@@ -31,13 +33,14 @@ KINDS = ("follower_controller", "move_base", "robot_state_publisher", "fake_loca
 
 SPACING = 1.2      # [m] between the formation's slots
 DISTANCE = 6.0     # [m] the formation drives east
-LEADER_X = -5.0    # [m] the leader's start in trio
+LEADER_X = -5.0    # [m] the leader's start
+WORLD = "field"
 
 
 def formation_scenario(robots):
     return {
         "description": "Fleet cost benchmark: %d robots in a triangle drive %g m east." % (robots, DISTANCE),
-        "world": "trio", "robots": robots, "formation": "triangle", "spacing": SPACING,
+        "world": WORLD, "robots": robots, "formation": "triangle", "spacing": SPACING,
         "time_limit": 150 + 5 * robots,
         "timeline": [{"at": 0, "do": {"target": [LEADER_X + DISTANCE, 0.0, 0.0]}}],
         "criteria": {"lost_at_end": 0},
@@ -49,7 +52,7 @@ def navigation_scenario(robots):
     goals = [[2.0 + SPACING * (i // 10), -5.4 + SPACING * (i % 10), 0.0] for i in range(robots)]
     return {
         "description": "Fleet cost benchmark: %d robots, a move_base goal each, no formation." % robots,
-        "world": "trio", "robots": robots, "mode": "dispatch",
+        "world": WORLD, "robots": robots, "mode": "dispatch",
         "time_limit": 150 + 5 * robots,
         "timeline": [{"at": 0, "do": {"dispatch": goals}}],
     }
