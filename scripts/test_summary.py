@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Summarise JUnit XML results from pytest, gtest and rostest into one report.
 
-Usage: test_summary.py DIR [DIR ...]
+Usage: test_summary.py [--expect FILE --src DIR] DIR [DIR ...]
 
 Prints one line per result file with failures, then the end of each failure's message (so that
 a CI log, which keeps the tail, shows why), then the totals as the plain closing line
@@ -10,6 +10,13 @@ rostest writes a `rostest-*.xml` file with one case per test node (did it run an
 node's own `rosunit-*.xml` with its test cases. The node's cases are counted; the rostest case
 counts only when it failed (the node crashed or timed out before writing its results), so that
 no test counts twice.
+
+--expect FILE: the result files a complete run has (one name a line, as found under the DIRs,
+e.g. `mbot_sim/gtest-test_world.xml`). A test that a partial build loses (a guard in a
+CMakeLists, a target that failed to build) writes no result and reads as nothing at all; with the
+list it is a failure naming the missing file. A skipped test case is a failure too, and so is a
+rostest file under `--src`'s packages (`src/<pkg>/test/**/*.test`) or a result file that is not
+in the list: a new test is added to the list in the same commit.
 """
 import os
 import sys
@@ -67,17 +74,74 @@ def message_tail(text, first=2, last=6):
     return kept[:first] + ["..."] + kept[-last:]
 
 
-def main(dirs):
+def result_name(path, dirs):
+    """A result file's name in the expected list: its path below the DIR it was found in."""
+    for top in dirs:
+        rel = os.path.relpath(path, top)
+        if not rel.startswith(".."):
+            return rel.replace(os.sep, "/")
+    return os.path.basename(path)
+
+
+def rostest_results(src):
+    """{expected result name: .test file} for every rostest file of every package under `src`:
+    catkin's add_rostest names the result rostest-<path below the package, / as _>.xml."""
+    out = {}
+    for pkg in sorted(os.listdir(src)) if os.path.isdir(src) else []:
+        test_dir = os.path.join(src, pkg, "test")
+        for root, _, files in os.walk(test_dir):
+            for name in sorted(files):
+                if name.endswith(".test"):
+                    rel = os.path.relpath(os.path.join(root, name), os.path.join(src, pkg))[:-len(".test")]
+                    out["%s/rostest-%s.xml" % (pkg, rel.replace(os.sep, "_"))] = os.path.join(root, name)
+    return out
+
+
+def completeness(found, expected, src):
+    """Failures (name, message) of a run that is not complete: expected results missing, rostest
+    files or results that the list does not know."""
+    failures = []
+    for name in sorted(set(expected) - set(found)):
+        failures.append((name, "expected result missing: the test did not build, was not registered or "
+                               "did not run (tests/expected_results.txt)"))
+    for name, path in sorted(rostest_results(src).items()) if src else []:
+        if name not in expected:
+            failures.append((name, "%s has no line in tests/expected_results.txt: add %s" % (path, name)))
+    for name in sorted(set(found) - set(expected)):
+        if not os.path.basename(name).startswith("rosunit-"):   # a rostest's own cases; its rostest- file is listed
+            failures.append((name, "a result that tests/expected_results.txt does not list: add it"))
+    return failures
+
+
+def main(argv):
+    expected, src = None, None
+    if argv[:1] == ["--expect"]:
+        with open(argv[1]) as f:
+            expected = [line.strip() for line in f if line.strip() and not line.startswith("#")]
+        argv = argv[2:]
+        if argv[:1] == ["--src"]:
+            src, argv = argv[1], argv[2:]
+    dirs = argv
     totals = [0, 0, 0]
     details = []
+    found = []
     for path in result_files(dirs):
+        found.append(result_name(path, dirs))
         p, f, s, failures = count(path)
+        if expected is not None and s:
+            failures.append(("%s (%d skipped)" % (found[-1], s), "a skipped test is a test that did not run"))
+            f += 1
         totals[0] += p
         totals[1] += f
         totals[2] += s
         rel = os.path.relpath(path)
         print("  %-70s %4d passed %3d failed %3d skipped" % (rel[-70:], p, f, s))
         for name, message in failures:
+            print("      FAILED: %s" % name)
+            details.append((name, message))
+    if expected is not None:
+        for name, message in completeness(found, expected, src):
+            totals[1] += 1
             print("      FAILED: %s" % name)
             details.append((name, message))
     for name, message in details:

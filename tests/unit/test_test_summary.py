@@ -87,3 +87,54 @@ def test_failure_message_is_printed_before_the_totals(tmp_path):
     assert lines[-1] == "0 passed, 1 failed, 0 skipped"
     reason = [i for i, line in enumerate(lines) if "slot RMS 0.93 m over the 0.5 m bound" in line]
     assert reason and reason[0] > [i for i, line in enumerate(lines) if "FAILED corridor" in line][0]
+
+
+# --- --expect: a run that lost a test is a failed run ----------------------------------------------
+
+def run_expecting(tmp_path, results, expected, test_files=()):
+    """results: {relative path under the results dir: XML}; expected: the list's lines;
+    test_files: rostest files of a package tree under tmp_path/src."""
+    out = tmp_path / "results"
+    for name, text in results.items():
+        (out / name).parent.mkdir(parents=True, exist_ok=True)
+        (out / name).write_text(text)
+    for name in test_files:
+        (tmp_path / "src" / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "src" / name).write_text("<launch/>")
+    (tmp_path / "src").mkdir(exist_ok=True)
+    listing = tmp_path / "expected.txt"
+    listing.write_text("# comment\n" + "\n".join(expected) + "\n")
+    proc = subprocess.run([sys.executable, SUMMARY, "--expect", str(listing), "--src", str(tmp_path / "src"),
+                           str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    return proc.returncode, proc.stdout
+
+
+def test_a_complete_run_passes(tmp_path):
+    results = {"pkg/rostest-test_sim.xml": ROSTEST_NODE_RAN, "pkg/rosunit-sim.xml": ROSTEST_XML,
+               "pkg/gtest-test_a.xml": ROSTEST_XML}
+    code, out = run_expecting(tmp_path, results,
+                              ["pkg/rostest-test_sim.xml", "pkg/gtest-test_a.xml"], ["pkg/test/sim.test"])
+    assert code == 0, out
+    assert out.strip().splitlines()[-1] == "4 passed, 0 failed, 0 skipped"
+
+
+def test_an_expected_result_that_is_missing_fails_the_run(tmp_path):
+    code, out = run_expecting(tmp_path, {"pkg/gtest-test_a.xml": ROSTEST_XML},
+                              ["pkg/gtest-test_a.xml", "pkg/gtest-test_raycast.xml"])
+    assert code == 1
+    assert "pkg/gtest-test_raycast.xml" in out and "expected result missing" in out
+    assert out.strip().splitlines()[-1] == "2 passed, 1 failed, 0 skipped"
+
+
+def test_a_skipped_case_fails_the_run(tmp_path):
+    code, out = run_expecting(tmp_path, {"pytest.xml": GTEST_XML.replace('<failure message="x"/>', "")},
+                              ["pytest.xml"])
+    assert code == 1 and "a skipped test is a test that did not run" in out
+
+
+def test_a_rostest_file_or_a_result_the_list_does_not_know_fails_the_run(tmp_path):
+    code, out = run_expecting(tmp_path, {"pkg/gtest-test_a.xml": ROSTEST_XML, "pkg/gtest-test_new.xml": ROSTEST_XML},
+                              ["pkg/gtest-test_a.xml"], ["pkg/test/rostest/new_check.test"])
+    assert code == 1
+    assert "add pkg/rostest-test_rostest_new_check.xml" in out
+    assert "pkg/gtest-test_new.xml" in out and "does not list" in out
