@@ -17,6 +17,8 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <boost/make_shared.hpp>
+
 #include <cmath>
 
 namespace mbot_sim
@@ -102,6 +104,7 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   contact_pub_ = nh_.advertise<mbot_msgs::Contact>("contacts", 100);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("stage/markers", 1, true);
+  tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
   for (int id : world_->robotIds()) addRobotIo(id);
   publishRobotList();
   publishMarkers();
@@ -275,8 +278,12 @@ void StageRos::run()
     world_->step();  // calls the on*() listeners, which publish
     if (!tf_batch_.empty())
     {
-      tf_broadcaster_.sendTransform(tf_batch_);
-      tf_batch_.clear();
+      // One message for all robots, published as a shared pointer: this node's own /tf subscriber
+      // (lockstep) then gets it as it is, not serialized and deserialized again.
+      auto tf = boost::make_shared<tf2_msgs::TFMessage>();
+      tf->transforms.swap(tf_batch_);
+      tf_batch_.reserve(tf->transforms.size());
+      tf_pub_.publish(tf);
     }
     publishClock();
     if (params_.lockstep) noteBoundary();

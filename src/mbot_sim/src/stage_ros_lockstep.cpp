@@ -125,7 +125,9 @@ bool StageRos::waitForControllers()
       }
       break;
     }
-    queue.callAvailable(ros::WallDuration(0.001));  // sleeps until a callback is ready, at most 1 ms
+    // Sleeps until a callback is ready (an answer, a transform, a heartbeat, a service call), at most
+    // 50 ms: besides callbacks only the wall clock and shutdown change what this loop waits for.
+    queue.callAvailable(ros::WallDuration(0.05));
   }
   for (auto& io : io_)  // each cmd_vel releases one boundary
     if (io && io->cmd_boundary >= boundary_count_ - 1) io->cmd_unused = false;

@@ -28,7 +28,6 @@
 #include <std_msgs/Header.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <boost/thread/recursive_mutex.hpp>
 
@@ -162,7 +161,7 @@ private:
   // the loop's thread between two steps, like every other service here; no step runs meanwhile.
   boost::recursive_mutex reconfigure_mutex_;  ///< given to the server, so that updateConfig() is safe
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_server_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom -> base_footprint
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
   double next_marker_time_ = 0.0;
   ros::WallTime next_marker_wall_;
