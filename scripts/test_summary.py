@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Summarise JUnit XML results from pytest, gtest and rostest into one report.
 
-Usage: test_summary.py [--expect FILE --src DIR] DIR [DIR ...]
+Usage: test_summary.py [--expect FILE --src DIR] [--system DIR] DIR [DIR ...]
 
 Prints one line per result file with failures, then the end of each failure's message (so that
 a CI log, which keeps the tail, shows why), then the totals as the plain closing line
@@ -83,6 +83,14 @@ def result_name(path, dirs):
     return os.path.basename(path)
 
 
+def system_results(system):
+    """{expected result name: .test file} of scripts/test's system rostests (`system`/*.test,
+    run as package mbot_system_tests with --results-filename system_<name>.xml)."""
+    names = sorted(os.listdir(system)) if system and os.path.isdir(system) else []
+    return {"mbot_system_tests/rostest-system_%s.xml" % n[:-len(".test")]: os.path.join(system, n)
+            for n in names if n.endswith(".test")}
+
+
 def rostest_results(src):
     """{expected result name: .test file} for every rostest file of every package under `src`:
     catkin's add_rostest names the result rostest-<path below the package, / as _>.xml."""
@@ -97,14 +105,16 @@ def rostest_results(src):
     return out
 
 
-def completeness(found, expected, src):
+def completeness(found, expected, src, system=None):
     """Failures (name, message) of a run that is not complete: expected results missing, rostest
     files or results that the list does not know."""
     failures = []
     for name in sorted(set(expected) - set(found)):
         failures.append((name, "expected result missing: the test did not build, was not registered or "
                                "did not run (tests/expected_results.txt)"))
-    for name, path in sorted(rostest_results(src).items()) if src else []:
+    files = dict(rostest_results(src)) if src else {}
+    files.update(system_results(system))
+    for name, path in sorted(files.items()):
         if name not in expected:
             failures.append((name, "%s has no line in tests/expected_results.txt: add %s" % (path, name)))
     for name in sorted(set(found) - set(expected)):
@@ -121,6 +131,9 @@ def main(argv):
         argv = argv[2:]
         if argv[:1] == ["--src"]:
             src, argv = argv[1], argv[2:]
+    system = None
+    if argv[:1] == ["--system"]:
+        system, argv = argv[1], argv[2:]
     dirs = argv
     totals = [0, 0, 0]
     details = []
@@ -140,7 +153,7 @@ def main(argv):
             print("      FAILED: %s" % name)
             details.append((name, message))
     if expected is not None:
-        for name, message in completeness(found, expected, src):
+        for name, message in completeness(found, expected, src, system):
             totals[1] += 1
             print("      FAILED: %s" % name)
             details.append((name, message))
