@@ -90,6 +90,7 @@ class RobotTfListener(object):
         self.topic = topic
         self._msg = TFMessage
         self._subs = {}
+        self._since = {}          # robot -> the clock at its first message
         self._lock = threading.Lock()
         self._last_update = 0.0   # [s] the clock at the newest message
         if source == "tf":
@@ -106,18 +107,32 @@ class RobotTfListener(object):
         with self._lock:
             for robot in set(self._subs) - set(robots):
                 self._subs.pop(robot).unregister()
+                self._since.pop(robot, None)
             for robot in set(robots) - set(self._subs):
                 self._subs[robot] = rospy.Subscriber("/%s/%s" % (robot, self.topic), self._msg, self._on_tf,
-                                                     queue_size=100, tcp_nodelay=True)
+                                                     robot, queue_size=100, tcp_nodelay=True)
+
+    def warm(self, robots, now, history):
+        """True once the poses of every robot of `robots` have come in for `history` [s] up to
+        `now`. A robot followed only now has none: a post-dated map -> odom begins after its
+        odometry, and lookups fail until sim time has passed the first one (a full /tf listener,
+        subscribed from the start, never saw that)."""
+        if self.source == "tf":
+            return True
+        with self._lock:
+            return all(r in self._since and now - self._since[r] >= history for r in robots)
 
     def robots(self):
         with self._lock:
             return set(self._subs)
 
-    def _on_tf(self, msg):
+    def _on_tf(self, msg, robot=None):
         import rospy
 
         now = rospy.get_time()
+        with self._lock:
+            if robot is not None and robot in self._subs:
+                self._since.setdefault(robot, now)
         if now + 1.0 < self._last_update:   # sim time jumped back (a reset): as tf2_ros does
             self.buffer.clear()
         self._last_update = now

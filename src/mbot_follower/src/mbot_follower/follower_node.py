@@ -278,8 +278,11 @@ class FollowerController(object):
             self._read_params(self._param_cache.values())
             self._last_param_read = now
         a = self.assignment
+        tf_warm = True
         if self._tf is not None:
-            self._tf.follow(self._robots_needed(a))
+            needed = self._robots_needed(a)
+            self._tf.follow(needed)
+            tf_warm = self._tf.warm(needed, now.to_sec(), 2.0 * self.params["max_pose_age"])
         if a is None or self.robot not in a.slots:
             # Not (yet) in the formation: stand still. The command also tells the simulator's
             # lockstep to wait for this node, so sim time cannot run away from the fleet.
@@ -296,6 +299,12 @@ class FollowerController(object):
         if self.fleet_state in HOLD_STATES or self.paused:
             self._hold()
             self._publish_state(now, "paused" if self.paused else "hold", started)
+            return
+
+        if not tf_warm:
+            # a robot it began to follow just now: no lookup until its poses have come in
+            self._hold()
+            self._publish_state(now, "no_pose", started)
             return
 
         # star: every follower tracks the leader; chain: the robot ahead of it (a.follows)

@@ -148,6 +148,26 @@ def test_the_robot_tf_listener_subscribes_only_the_robots_it_follows_and_lookups
     assert pose.x == pytest.approx(3.0) and stamp.to_sec() == pytest.approx(10.0)
 
 
+def test_a_robot_followed_only_now_is_not_looked_up_until_its_poses_have_come_in_for_a_while(monkeypatch):
+    import tf2_ros
+    from tf2_msgs.msg import TFMessage
+
+    subs = _Subscriptions()
+    monkeypatch.setattr(rospy, "Subscriber", subs)
+    clock = [10.0]
+    monkeypatch.setattr(rospy, "get_time", lambda: clock[0])
+    listener = fleet_io.RobotTfListener(tf2_ros.Buffer(debug=False))
+    listener.follow({"leader"})
+    assert not listener.warm({"leader"}, 10.0, 0.2)          # nothing came in yet
+    subs.topics["/leader/tf_pose"](TFMessage([_transform("leader/odom", "leader/base_footprint", 10.0)]), "leader")
+    clock[0] = 10.1
+    assert not listener.warm({"leader"}, 10.1, 0.2)          # 0.1 s of poses: a post-dated map -> odom may lack
+    assert listener.warm({"leader"}, 10.25, 0.2)
+    listener.follow({"follower_1"})                          # dropped and followed again later: cold again
+    listener.follow({"leader"})
+    assert not listener.warm({"leader"}, 10.5, 0.2)
+
+
 def test_the_robot_tf_listener_refuses_an_unknown_source():
     with pytest.raises(ValueError, match="expected relay or tf"):
         fleet_io.RobotTfListener(None, source="all")
