@@ -14,9 +14,10 @@ no test counts twice.
 --expect FILE: the result files a complete run has (one name a line, as found under the DIRs,
 e.g. `mbot_sim/gtest-test_world.xml`). A test that a partial build loses (a guard in a
 CMakeLists, a target that failed to build) writes no result and reads as nothing at all; with the
-list it is a failure naming the missing file. A skipped test case is a failure too, and so is a
-rostest file under `--src`'s packages (`src/<pkg>/test/**/*.test`) or a result file that is not
-in the list: a new test is added to the list in the same commit.
+list it is a failure naming the missing file. Every rostest file under `--src`'s packages
+(`src/<pkg>/test/**/*.test`) and `--system` is expected too, without a line. A skipped test case
+is a failure, and so is a result file that nothing expects: a new gtest is added to the list in
+the same commit.
 """
 import os
 import sys
@@ -106,18 +107,17 @@ def rostest_results(src):
 
 
 def completeness(found, expected, src, system=None):
-    """Failures (name, message) of a run that is not complete: expected results missing, rostest
-    files or results that the list does not know."""
+    """Failures (name, message) of a run that is not complete: an expected result missing (the
+    list's, and one per rostest file on disk), or a result that nothing expects."""
     failures = []
-    for name in sorted(set(expected) - set(found)):
-        failures.append((name, "expected result missing: the test did not build, was not registered or "
-                               "did not run (tests/expected_results.txt)"))
     files = dict(rostest_results(src)) if src else {}
     files.update(system_results(system))
-    for name, path in sorted(files.items()):
-        if name not in expected:
-            failures.append((name, "%s has no line in tests/expected_results.txt: add %s" % (path, name)))
-    for name in sorted(set(found) - set(expected)):
+    expected = set(expected) | set(files)
+    for name in sorted(expected - set(found)):
+        why = ("%s wrote no result: it is not registered (add_rostest) or did not run" % files[name]) \
+            if name in files else "the test did not build, was not registered or did not run"
+        failures.append((name, "expected result missing: " + why))
+    for name in sorted(set(found) - expected):
         if not os.path.basename(name).startswith("rosunit-"):   # a rostest's own cases; its rostest- file is listed
             failures.append((name, "a result that tests/expected_results.txt does not list: add it"))
     return failures

@@ -132,9 +132,9 @@ def test_a_skipped_case_fails_the_run(tmp_path):
     assert code == 1 and "a skipped test is a test that did not run" in out
 
 
-def test_a_rostest_file_or_a_result_the_list_does_not_know_fails_the_run(tmp_path):
+def test_a_rostest_file_without_a_result_or_a_result_nothing_expects_fails_the_run(tmp_path):
     code, out = run_expecting(tmp_path, {"pkg/gtest-test_a.xml": ROSTEST_XML, "pkg/gtest-test_new.xml": ROSTEST_XML},
                               ["pkg/gtest-test_a.xml"], ["pkg/test/rostest/new_check.test"])
     assert code == 1
-    assert "add pkg/rostest-test_rostest_new_check.xml" in out
+    assert "pkg/rostest-test_rostest_new_check.xml" in out and "is not registered (add_rostest)" in out
     assert "pkg/gtest-test_new.xml" in out and "does not list" in out
