@@ -297,6 +297,7 @@ void readFootprint(const UrdfReader& urdf, RobotModel& model)
 void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotModel& model)
 {
   double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;
+  model.wheel_frames.clear();
   for (std::size_t i = 0; i < model.wheel_joints.size(); ++i)
   {
     const std::string& name = model.wheel_joints[i];
@@ -320,6 +321,22 @@ void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotMod
                                                                      formatNumber(model.wheel_radius) + " m), got " +
                                                                      formatNumber(radius));
     model.wheel_radius = radius;
+
+    WheelJointFrame frame;
+    frame.parent = joint->parent_link_name;
+    frame.child = joint->child_link_name;
+    const urdf::Pose& origin = joint->parent_to_joint_origin_transform;
+    frame.origin_xyz[0] = origin.position.x;
+    frame.origin_xyz[1] = origin.position.y;
+    frame.origin_xyz[2] = origin.position.z;
+    origin.rotation.getQuaternion(frame.origin_q[0], frame.origin_q[1], frame.origin_q[2], frame.origin_q[3]);
+    const double norm =
+        std::sqrt(joint->axis.x * joint->axis.x + joint->axis.y * joint->axis.y + joint->axis.z * joint->axis.z);
+    if (norm < kTolerance) urdf.fail("joint " + name + " axis", "expected a non-zero axis");
+    frame.axis[0] = joint->axis.x / norm;
+    frame.axis[1] = joint->axis.y / norm;
+    frame.axis[2] = joint->axis.z / norm;
+    model.wheel_frames.push_back(frame);
 
     // The wheel's axle is the joint frame, which is also the wheel link frame.
     const urdf::Vector3 axle = urdf.linkPose(joint->child_link_name).pose.position;

@@ -86,6 +86,15 @@ TEST(RobotModel, MbotMatchesItsUrdf)
   ASSERT_EQ(m.wheel_joints.size(), 2u);
   EXPECT_EQ(m.wheel_joints[0], "left_wheel_joint");
   EXPECT_EQ(m.wheel_joints[1], "right_wheel_joint");
+  // The wheels' joint frames as the URDF writes them (the simulator publishes them on /tf).
+  ASSERT_EQ(m.wheel_frames.size(), 2u);
+  EXPECT_EQ(m.wheel_frames[0].parent, "base_link");
+  EXPECT_EQ(m.wheel_frames[0].child, "left_wheel");
+  EXPECT_EQ(m.wheel_frames[1].child, "right_wheel");
+  EXPECT_NEAR(m.wheel_frames[0].origin_xyz[1], 0.11, kEps);
+  EXPECT_NEAR(m.wheel_frames[1].origin_xyz[1], -0.11, kEps);
+  EXPECT_NEAR(m.wheel_frames[0].origin_q[3], 1.0, kEps);
+  EXPECT_NEAR(m.wheel_frames[0].axis[1], 1.0, kEps);
 
   EXPECT_NEAR(m.laser.mount_x, 0.05, kEps);
   EXPECT_NEAR(m.laser.mount_y, 0.0, kEps);

@@ -50,6 +50,9 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
     throw StartupError(pnh.resolveName("base_watchdog_timeout") + ": expected a number > 0 [s]");
   pnh.param("marker_rate", p.marker_rate, 10.0);
   if (!(p.marker_rate > 0.0)) throw StartupError(pnh.resolveName("marker_rate") + ": expected a number > 0 [Hz]");
+  pnh.param("wheel_tf_rate", p.wheel_tf_rate, 10.0);
+  if (!(p.wheel_tf_rate >= 0.0))
+    throw StartupError(pnh.resolveName("wheel_tf_rate") + ": expected a number >= 0 [Hz] (0: no wheel transforms)");
   pnh.param("lockstep", p.lockstep, false);
   pnh.param("lockstep_period", p.lockstep_period, 0.05);
   if (!(p.lockstep_period > 0.0))

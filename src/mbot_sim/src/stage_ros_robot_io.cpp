@@ -28,6 +28,20 @@ void fillOdometry(nav_msgs::Odometry& msg, double stamp, const Pose2D& pose, con
   msg.twist.twist.angular.z = twist.wz;
 }
 
+/// The rotation `q` (x, y, z, w) followed by `angle` about the unit `axis`: a revolute joint's
+/// origin rotation composed with its position.
+geometry_msgs::Quaternion jointRotation(const double q[4], const double axis[3], double angle)
+{
+  const double s = std::sin(angle / 2.0);
+  const double b[4] = {axis[0] * s, axis[1] * s, axis[2] * s, std::cos(angle / 2.0)};
+  geometry_msgs::Quaternion out;
+  out.x = q[3] * b[0] + q[0] * b[3] + q[1] * b[2] - q[2] * b[1];
+  out.y = q[3] * b[1] - q[0] * b[2] + q[1] * b[3] + q[2] * b[0];
+  out.z = q[3] * b[2] + q[0] * b[1] - q[1] * b[0] + q[2] * b[3];
+  out.w = q[3] * b[3] - q[0] * b[0] - q[1] * b[1] - q[2] * b[2];
+  return out;
+}
+
 }  // namespace
 
 // =============================================================================================
@@ -72,6 +86,18 @@ void StageRos::addRobotIo(int id)
   io->scan_msg.range_min = m.laser.range_min;
   io->scan_msg.range_max = m.laser.range_max;
   for (const auto& joint : m.wheel_joints) io->joint_msg.name.push_back(io->prefix + joint);
+  // The wheels' transforms (as Gazebo's diff drive plugin's publishWheelTF): robot_state_publisher
+  // then needs no joint_states, and publishes only the fixed joints, once, on /tf_static.
+  for (const auto& frame : m.wheel_frames)
+  {
+    geometry_msgs::TransformStamped tf;
+    tf.header.frame_id = io->prefix + frame.parent;
+    tf.child_frame_id = io->prefix + frame.child;
+    tf.transform.translation.x = frame.origin_xyz[0];
+    tf.transform.translation.y = frame.origin_xyz[1];
+    tf.transform.translation.z = frame.origin_xyz[2];
+    io->wheel_tf.push_back(tf);
+  }
   if (id >= static_cast<int>(io_.size())) io_.resize(id + 1);
   io_[id] = std::move(io);
 }
@@ -105,7 +131,20 @@ void StageRos::onJointState(int robot, const JointStateSample& s)
   io.joint_msg.header.stamp.fromSec(s.stamp);
   io.joint_msg.position = s.position;
   io.joint_msg.velocity = s.velocity;
-  io.joint_states.publish(io.joint_msg);
+  io.joint_states.publish(io.joint_msg);  // serialized only when someone subscribes
+
+  if (params_.wheel_tf_rate <= 0.0 || s.stamp < io.next_wheel_tf) return;
+  const double period = 1.0 / params_.wheel_tf_rate;
+  io.next_wheel_tf += period;
+  if (io.next_wheel_tf <= s.stamp) io.next_wheel_tf = s.stamp + period;  // first time, or after a reset
+  const auto& frames = world_->robotModel(robot).wheel_frames;
+  for (std::size_t i = 0; i < io.wheel_tf.size() && i < s.position.size(); ++i)
+  {
+    geometry_msgs::TransformStamped& tf = io.wheel_tf[i];
+    tf.header.stamp = io.joint_msg.header.stamp;
+    tf.transform.rotation = jointRotation(frames[i].origin_q, frames[i].axis, s.position[i]);
+    tf_batch_.push_back(tf);
+  }
 }
 
 void StageRos::onScan(int robot, const ScanSample& s)

@@ -10,6 +10,7 @@ import math
 import sys
 import unittest
 
+import rosgraph
 import rospy
 import rostest
 import tf2_ros
@@ -17,7 +18,8 @@ from geometry_msgs.msg import Twist
 from mbot_common.geometry import yaw_of
 from mbot_msgs.msg import Contact
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import JointState, LaserScan
+from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
@@ -169,6 +171,47 @@ class SimBasics(unittest.TestCase):
         self.assertEqual(len(disc), 1,
                          "no disc at robot_1's pose (%.2f, %.2f) at t=%.2f" % (truth.x, truth.y, stamp.to_sec()))
         self.assertAlmostEqual(disc[0].scale.x, 2 * RADIUS, delta=1e-6)
+
+    def test_7_the_simulator_publishes_the_wheels_and_robot_state_publisher_reads_no_joint_states(self):
+        """stage_node puts <ns>/base_link -> <ns>/<wheel> on /tf at ~wheel_tf_rate (10 Hz), at the
+        angle its joint_states give; robot_state_publisher only has the fixed joints to publish."""
+        left = []  # (stamp [s], publisher, parent, y, angle about +y)
+
+        def on_tf(msg):
+            for t in msg.transforms:
+                if t.child_frame_id == "robot_0/left_wheel":
+                    q = t.transform.rotation
+                    left.append((t.header.stamp.to_sec(), msg._connection_header.get("callerid"), t.header.frame_id,
+                                 t.transform.translation.y, 2.0 * math.atan2(q.y, q.w)))
+
+        tf_sub = rospy.Subscriber("/tf", TFMessage, on_tf, queue_size=1000)
+        joints = Recorder("/robot_0/joint_states", JointState)
+        joints.wait_for_first()
+        t0 = rospy.get_time() + 0.5
+        publish_for(self.cmd["robot_0"], twist(0.0, 1.0), 3.0)  # in place: the left wheel turns backwards
+        self.cmd["robot_0"].publish(twist(0.0))
+        tf_sub.unregister()
+        window = [w for w in left if t0 <= w[0] < t0 + 2.0]
+        self.assertTrue(18 <= len(window) <= 22, "%d wheel transforms in 2 s of sim time, expected 10 Hz" % len(window))
+        self.assertEqual({w[1] for w in window}, {"/stage_node"})
+        self.assertEqual({w[2] for w in window}, {"robot_0/base_link"})
+        for w in window:
+            self.assertAlmostEqual(w[3], 0.11, delta=1e-9)  # the URDF's joint origin
+        angles = {round(m.header.stamp.to_sec(), 6): m.position[0] for m in joints.since(0.0)}
+        matched = 0
+        for stamp, _, _, _, angle in window:
+            if round(stamp, 6) in angles:
+                diff = math.atan2(math.sin(angle - angles[round(stamp, 6)]), math.cos(angle - angles[round(stamp, 6)]))
+                self.assertAlmostEqual(diff, 0.0, delta=1e-6)
+                matched += 1
+        self.assertGreater(matched, 10, "few wheel transforms had a joint_states message of the same stamp")
+        turned = sum(math.atan2(math.sin(b[4] - a[4]), math.cos(b[4] - a[4])) for a, b in zip(window, window[1:]))
+        # wz = 1 rad/s: the left wheel (y = +0.11 m, r = 0.04 m) rolls at -2.75 rad/s, ~ -5.5 rad in 2 s
+        self.assertLess(turned, -3.0, "the left wheel turned %.2f rad while the robot turned left" % turned)
+        # robot_state_publisher runs (test_5 resolves the laser) but reads no joint_states
+        _, subscribers, _ = rosgraph.Master("/test_sim_basics").getSystemState()
+        readers = dict(subscribers).get("/robot_0/joint_states", [])
+        self.assertNotIn("/robot_0/robot_state_publisher", readers)
 
 
 if __name__ == "__main__":

@@ -74,18 +74,30 @@ struct Limits
   double acc_lim_theta = 3.0;  ///< [rad/s^2]
 };
 
+/// @brief A wheel's joint as the URDF places it: the child link turns about `axis` (in the joint
+///        frame) at `origin` in the parent link. The simulator publishes parent -> child on /tf.
+struct WheelJointFrame
+{
+  std::string parent;                         ///< unprefixed parent link (base_link)
+  std::string child;                          ///< unprefixed wheel link
+  double origin_xyz[3] = {0.0, 0.0, 0.0};     ///< [m]
+  double origin_q[4] = {0.0, 0.0, 0.0, 1.0};  ///< rotation x, y, z, w
+  double axis[3] = {0.0, 1.0, 0.0};           ///< unit vector
+};
+
 /// @brief Everything the simulator and the navigation need to know about one robot model.
 struct RobotModel
 {
   std::string name;  ///< "mbot" or "mbot_omni"
   DriveType drive = DriveType::DIFF;
-  double footprint_radius = 0.0;          ///< radius of the circle around the footprint [m]
-  std::vector<Point2> footprint;          ///< footprint polygon in base_footprint, counter-clockwise [m]
-  double mass = 0.0;                      ///< total mass [kg] (sum of URDF link masses)
-  double wheel_radius = 0.0;              ///< [m]
-  double wheel_separation = 0.0;          ///< distance between left and right wheels [m]
-  double wheel_base = 0.0;                ///< distance between front and rear wheels [m] (0: one axle)
-  std::vector<std::string> wheel_joints;  ///< unprefixed URDF joint names of the driven wheels
+  double footprint_radius = 0.0;              ///< radius of the circle around the footprint [m]
+  std::vector<Point2> footprint;              ///< footprint polygon in base_footprint, counter-clockwise [m]
+  double mass = 0.0;                          ///< total mass [kg] (sum of URDF link masses)
+  double wheel_radius = 0.0;                  ///< [m]
+  double wheel_separation = 0.0;              ///< distance between left and right wheels [m]
+  double wheel_base = 0.0;                    ///< distance between front and rear wheels [m] (0: one axle)
+  std::vector<std::string> wheel_joints;      ///< unprefixed URDF joint names of the driven wheels
+  std::vector<WheelJointFrame> wheel_frames;  ///< the same joints' frames, in the same order
   LaserSpec laser;
   Limits limits;
   double odom_rate = 50.0;          ///< [Hz]

@@ -58,6 +58,8 @@ struct StageParams
   int seed = 0;                            ///< ~seed: overrides the world file's when set
   double watchdog_timeout = 0.2;           ///< ~base_watchdog_timeout [s sim time]
   double marker_rate = 10.0;               ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+  double wheel_tf_rate = 10.0;             ///< ~wheel_tf_rate: <ns>/base_link -> <ns>/<wheel> on /tf [Hz sim
+                                           ///< time]; 0: not published (robot_state_publisher from joint_states)
   bool lockstep = false;                   ///< ~lockstep: hold sim time at period boundaries for the controllers
   double lockstep_period = 0.05;           ///< ~lockstep_period: distance of the boundaries [s sim time]
   double lockstep_active_timeout = 0.5;    ///< ~lockstep_active_timeout: a robot is driven while its
@@ -104,6 +106,8 @@ private:
     sensor_msgs::LaserScan scan_msg;
     sensor_msgs::JointState joint_msg;
     geometry_msgs::TransformStamped odom_tf;
+    std::vector<geometry_msgs::TransformStamped> wheel_tf;  ///< parent link -> wheel, one per wheel joint
+    double next_wheel_tf = 0.0;                             ///< sim time the wheels go out next [s]
     double last_cmd_time = -1e9;        ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
     long cmd_boundary = -1;             ///< boundary_count_ when the last cmd_vel arrived
     bool cmd_unused = false;            ///< lockstep: the last cmd_vel has not released a boundary yet
@@ -161,8 +165,8 @@ private:
   // the loop's thread between two steps, like every other service here; no step runs meanwhile.
   boost::recursive_mutex reconfigure_mutex_;  ///< given to the server, so that updateConfig() is safe
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_server_;
-  ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom -> base_footprint
-  std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all odom tf of one step
+  ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom and wheel transforms
+  std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all transforms of one step
   double next_marker_time_ = 0.0;
   ros::WallTime next_marker_wall_;
 

@@ -6,8 +6,13 @@ This helper watches that list; for each new robot it sets ``/<name>/robot_descri
 robot's URDF with every link and joint prefixed ``<name>/`` (mbot_description's prefix_urdf, the
 same text description.launch sets) and starts ``robot_state_publisher`` in the namespace
 ``/<name>``, which then publishes ``<name>/base_footprint -> <name>/base_link -> <name>/base_laser``
-(and the wheels, from ``/<name>/joint_states``). For a removed robot it stops that process and
-deletes the parameter.
+on ``/tf_static``, once. The wheels' transforms come from stage_node itself (``~wheel_tf_rate``,
+as Gazebo's diff drive plugin's ``publishWheelTF``), so each robot_state_publisher is started
+with ``joint_states`` remapped to an unused name: robot_state_publisher 1.15 asks the master for
+``tf_prefix`` on every joint_states message, and at 50 Hz per robot those calls were all of the
+master's steady load. With ``~use_joint_states: true`` (stage_node's ``wheel_tf_rate: 0``) the
+publishers read ``/<name>/joint_states`` and publish the wheels, the usual way. For a removed
+robot it stops that process and deletes the parameter.
 """
 import os
 
@@ -43,8 +48,13 @@ def prefixed_description(description_dir, model, name):
 class RobotStatePublishers(object):
     """Starts and stops the robot_state_publisher processes (roslaunch's scriptapi)."""
 
-    def __init__(self, launcher, set_param, delete_param, description_dir, publish_frequency=50.0):
+    #: where joint_states goes when the simulator publishes the wheels (nobody publishes there)
+    UNUSED_JOINT_STATES = "robot_state_publisher/joint_states_unused"
+
+    def __init__(self, launcher, set_param, delete_param, description_dir, publish_frequency=50.0,
+                 use_joint_states=False):
         self._launcher = launcher          # roslaunch.scriptapi.ROSLaunch, started
+        self._use_joint_states = use_joint_states
         self._set_param = set_param
         self._delete_param = delete_param
         self._description_dir = description_dir
@@ -70,9 +80,10 @@ class RobotStatePublishers(object):
             model = wanted[name]
             self._set_param("/%s/robot_description" % name,
                             prefixed_description(self._description_dir, model, name))
+            remaps = [] if self._use_joint_states else [("joint_states", self.UNUSED_JOINT_STATES)]
             node = roslaunch.core.Node(
                 "robot_state_publisher", "robot_state_publisher", name="robot_state_publisher",
-                namespace="/" + name, output="log",
+                namespace="/" + name, output="log", remap_args=remaps,
                 args="_publish_frequency:=%g" % self._publish_frequency)
             self._processes[name] = self._launcher.launch(node)
             self._running[name] = model
@@ -83,7 +94,8 @@ class RobotStatePublishers(object):
 
 
 def main():
-    """Node: poll ``/stage/robots`` every ``~poll_period`` wall seconds (default 0.5)."""
+    """Node: look at ``/stage/robots`` every ``~poll_period`` wall seconds (default 0.5), from
+    rospy's parameter cache (the master calls back when stage_node changes it)."""
     import time
 
     import roslaunch
@@ -93,16 +105,17 @@ def main():
     rospy.init_node("robot_state_publishers")
     poll_period = float(rospy.get_param("~poll_period", 0.5))  # [s wall]
     publish_frequency = float(rospy.get_param("~publish_frequency", 50.0))  # [Hz]
+    use_joint_states = bool(rospy.get_param("~use_joint_states", False))
     description_dir = rospkg.RosPack().get_path("mbot_description")
 
     launcher = roslaunch.scriptapi.ROSLaunch()
     launcher.start()
     publishers = RobotStatePublishers(launcher, rospy.set_param, rospy.delete_param,
-                                      description_dir, publish_frequency)
+                                      description_dir, publish_frequency, use_joint_states)
     rospy.on_shutdown(publishers.stop_all)
     while not rospy.is_shutdown():
         try:
-            wanted = robot_set(rospy.get_param("/stage/robots", []))
+            wanted = robot_set(rospy.get_param_cached("/stage/robots", []))
         except (KeyError, TypeError) as error:
             rospy.logerr_throttle(10.0, "robot_state_publishers: bad /stage/robots: %s" % error)
             wanted = None

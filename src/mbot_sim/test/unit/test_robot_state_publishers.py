@@ -67,3 +67,15 @@ def test_update_sets_descriptions_launches_and_stops():
     pubs.stop_all()
     assert params == {}
     assert launcher.processes[1].stopped
+
+
+def test_publishers_ignore_joint_states_unless_asked():
+    """The simulator publishes the wheels' tf: robot_state_publisher must not also read
+    joint_states (each message costs it three master calls); with use_joint_states it does."""
+    launcher = FakeLauncher()
+    RobotStatePublishers(launcher, {}.__setitem__, {}.pop, DESCRIPTION_DIR).update({"robot_0": "mbot"})
+    assert launcher.launched[0].remap_args == [("joint_states", RobotStatePublishers.UNUSED_JOINT_STATES)]
+    launcher = FakeLauncher()
+    RobotStatePublishers(launcher, {}.__setitem__, {}.pop, DESCRIPTION_DIR,
+                         use_joint_states=True).update({"robot_0": "mbot"})
+    assert launcher.launched[0].remap_args == []
