@@ -19,6 +19,7 @@ def run(script, *args):
     ("bench", "usage: scripts/bench"),
     ("demo", "scripts/demo"),
     ("scenario", "scripts/scenario"),
+    ("fleet-hosts", "scripts/fleet-hosts run"),
 ])
 def test_help_prints_usage_without_building(script, words):
     result = run(script, "--help")
