@@ -5,8 +5,8 @@ Parameters: ~goals (dict robot -> [[x, y, yaw], ...]) or ~goals_file + ~world (a
 """
 
 import rospy
-import yaml
 from actionlib_msgs.msg import GoalStatus
+from mbot_common.strict_yaml import ConfigError, convert, describe, load_yaml
 
 from mbot_navigation.move_base_client import connect_move_base, make_goal
 
@@ -18,15 +18,38 @@ STATUS_NAMES = {GoalStatus.PENDING: "PENDING", GoalStatus.ACTIVE: "ACTIVE", Goal
                 GoalStatus.RECALLED: "RECALLED", GoalStatus.LOST: "LOST"}
 
 
+def check_goals(goals, where):
+    """The goal table {robot: [[x, y, yaw], ...]} checked: a map of robot names to non-empty lists
+    of three finite numbers each; a ConfigError names `where`, the robot and the goal otherwise."""
+    if not isinstance(goals, dict) or not goals:
+        raise ConfigError("%s: expected a map robot -> list of goals [x, y, yaw], got %s" % (where, describe(goals)))
+    table = {}
+    for robot, items in goals.items():
+        if not isinstance(items, list) or not items:
+            raise ConfigError("%s: %s: expected a non-empty list of goals [x, y, yaw], got %s"
+                              % (where, robot, describe(items)))
+        table[str(robot)] = []
+        for i, goal in enumerate(items):
+            numbers = goal if isinstance(goal, list) and len(goal) == 3 else None
+            values = [convert(v, float) for v in numbers] if numbers is not None else None  # None: not finite
+            if values is None or None in values:
+                raise ConfigError("%s: %s[%d]: expected [x, y, yaw] (three finite numbers: m, m, rad), got %s"
+                                  % (where, robot, i, describe(goal)))
+            table[str(robot)].append(values)
+    return table
+
+
 def load_goals(goals_file, world):
-    """Goals of `world` (a name or a world file path: its base name is the key) from the file."""
-    with open(goals_file) as f:
-        table = yaml.safe_load(f)
+    """Goals of `world` (a name or a world file path: its base name is the key) from the file,
+    checked (check_goals). ConfigError for a missing file, bad YAML, an unknown world or a bad goal."""
+    table = load_yaml(goals_file)
+    if not isinstance(table, dict):
+        raise ConfigError("%s: expected a map world -> goals, got %s" % (goals_file, describe(table)))
     key = world.split("/")[-1].replace(".world.yaml", "")
     if key not in table:
-        raise KeyError("%s: no goals for world '%s' (worlds with goals: %s)"
-                       % (goals_file, key, ", ".join(sorted(table))))
-    return table[key]
+        raise ConfigError("%s: no goals for world '%s' (worlds with goals: %s)"
+                          % (goals_file, key, ", ".join(sorted(table))))
+    return check_goals(table[key], "%s: %s" % (goals_file, key))
 
 
 class Tour(object):
@@ -68,9 +91,15 @@ class Tour(object):
 
 def main():
     rospy.init_node("goal_tour")
-    goals = rospy.get_param("~goals", None)
-    if goals is None:
-        goals = load_goals(rospy.get_param("~goals_file"), rospy.get_param("~world"))
+    try:
+        goals = rospy.get_param("~goals", None)
+        if goals is not None:
+            goals = check_goals(goals, rospy.resolve_name("~goals"))
+        else:
+            goals = load_goals(rospy.get_param("~goals_file"), rospy.get_param("~world"))
+    except (ConfigError, KeyError) as e:  # KeyError: neither ~goals nor ~goals_file and ~world
+        rospy.logfatal("goal_tour: %s", e if isinstance(e, ConfigError) else "missing parameter %s" % e)
+        return 1
     tours = [Tour(robot, goals[robot]) for robot in sorted(goals)]
     for tour in tours:
         try:
