@@ -380,7 +380,8 @@ def wait_stack_ready(master_uri, timeout):
     while time.time() < end:
         try:
             if master.getParam("/use_sim_time") is True:
-                return master.getParam("/fleet/world_file")
+                # the output of fleet_world (a command parameter): the path and a newline
+                return master.getParam("/fleet/world_file").strip()
         except Exception as error:  # noqa: B902 (no master yet, or the parameters are not set yet)
             last = error
         time.sleep(0.5)
@@ -482,7 +483,19 @@ def run(args):
             start_new_session=True)
         write_hosts_json(run_dir, scenario, hosts, placement, netem, master_uri,
                          "" if not netem else "tc netem" if kernel_netem else "user-space switch (fleet_link)")
-        status = runner.wait()
+        while runner.poll() is None:
+            gone = [k for k, process in sorted(stacks.items()) if process.poll() is not None]
+            if gone:
+                log = os.path.join(run_dir, "hosts", "h%d.log" % gone[0])
+                with open(log) as f:
+                    tail = "".join(f.readlines()[-8:])
+                say("error: %s's robots stopped (exit status %d): the run cannot go on. The end of %s:\n%s"
+                    % (hosts.name(gone[0]), stacks[gone[0]].returncode, log, tail))
+                stop(runner, "the scenario runner", waits=((signal.SIGINT, 120.0), (signal.SIGTERM, 15.0)), group=True)
+                runner = None
+                return 3
+            time.sleep(1.0)
+        status = runner.returncode
         runner = None
         return status
     except KeyboardInterrupt:
@@ -509,6 +522,7 @@ def run(args):
 def write_hosts_json(run_dir, scenario, hosts, placement, netem, master_uri, link):
     with open(os.path.join(run_dir, "hosts.json"), "w") as f:
         json.dump({"scenario": scenario.name, "master": master_uri, "netem": netem or "", "link": link,
+                   "namespaces": hosts.namespaces(),
                    "hosts": [{"name": hosts.name(k), "address": hosts.address(k), "robots": placement[k],
                               "runs": "master, simulator, map server, tf relay, coordinator, metrics, its robots"
                               if k == 1 else "its robots"} for k in sorted(placement)]}, f, indent=1)

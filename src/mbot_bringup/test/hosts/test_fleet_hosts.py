@@ -27,7 +27,6 @@ def test_trio_on_three_hosts_passes_its_criteria(tmp_path):
     if check.returncode != 0:
         pytest.fail("this machine does not allow network namespaces, so the 3-host trio was not run: "
                     + check.stdout.strip())
-    before = namespaces()
     run_dir = str(tmp_path / "trio")
     result = subprocess.run([SCRIPT, "run", "--hosts", "3", "triangle_trio", "--no-rviz", "--no-record",
                              "--run-dir", run_dir], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -45,6 +44,7 @@ def test_trio_on_three_hosts_passes_its_criteria(tmp_path):
               for c in criteria["criteria"] if not c["passed"]]
     assert not failed, "criteria failed: %s\n%s" % (", ".join(failed), tail)
     assert result.returncode == 0, tail
-    assert namespaces() == before, "namespaces left behind: %s" % sorted(namespaces() - before)
-    left = os.listdir("/etc/netns") if os.path.isdir("/etc/netns") else []
-    assert not [n for n in left if n.startswith("mbot")], "hosts files left in /etc/netns: %s" % left
+    left = sorted(set(hosts["namespaces"]) & namespaces())
+    assert not left, "namespaces left behind: %s" % left
+    left = [n for n in hosts["namespaces"] if os.path.exists(os.path.join("/etc/netns", n))]
+    assert not left, "hosts files left in /etc/netns: %s" % left
