@@ -7,7 +7,8 @@
 
 Every host is a network namespace with its own address (10.77.0.<k>/24 on eth0, and loopback);
 a switch namespace holds the bridge that joins them, so no packet of theirs touches the machine's
-own interfaces. Host names resolve inside the namespaces only: `ip netns exec NS` mounts
+own interfaces. Every host's route to the others has `quickack 1` (`--no-quickack`: without), see
+README. Host names resolve inside the namespaces only: `ip netns exec NS` mounts
 /etc/netns/NS/hosts over /etc/hosts for the command it runs (the machine's /etc/hosts is never
 written). `--netem` puts a Wi-Fi-like link on every host's interface (tc netem: each packet that
 leaves a host is delayed 20 ms +- 10 ms and 0.5 % of them are lost).
@@ -35,6 +36,8 @@ NETEM = "delay 20ms 10ms loss 0.5%"
 HOST_NAME = "mbot-h%d"             # resolvable inside the namespaces
 NO_NETEM = ("this kernel has no netem qdisc (CONFIG_NET_SCH_NETEM not set, or sch_netem not loaded): the link's "
             "delay and loss come from a switch in user space (mbot_bringup/fleet_link.py)")
+NO_QUICKACK = ("the hosts' routes without `quickack 1`: delayed ACKs, as a default Linux network has them "
+               "(README: A fleet across hosts)")
 MAX_HOSTS = 20
 MASTER_WAIT = 120.0                # [s wall] for host 1's master to come up
 STACK_WAIT = 120.0                 # [s wall] for a host's stack to see the master's parameters
@@ -216,7 +219,7 @@ def check_allowed(netem=None):
 class Hosts(object):
     """K hosts (namespaces PREFIX-h1..K) joined by a bridge in the namespace PREFIX-sw."""
 
-    def __init__(self, count, prefix="mbot"):
+    def __init__(self, count, prefix="mbot", quickack=True):
         if count < 1 or count > MAX_HOSTS:
             raise HostsError("%d hosts: expected 1 to %d" % (count, MAX_HOSTS))
         self.count = count
@@ -224,6 +227,7 @@ class Hosts(object):
         self.switch = "%s-sw" % prefix
         self.made_etc_netns = False
         self.link = None           # the user-space switch's process (no kernel netem)
+        self.quickack = quickack
 
     def ns(self, k):
         return "%s-h%d" % (self.prefix, k)
@@ -275,6 +279,10 @@ class Hosts(object):
                 _ip("-n", ns, "addr", "add", "%s/24" % self.address(k), "dev", "eth0")
                 _ip("-n", ns, "link", "set", "eth0", "up")
                 _ip("-n", ns, "link", "set", "lo", "up")
+                if self.quickack:
+                    # ACK at once: ROS 1 subscriptions without TCP_NODELAY (scans, odometry) otherwise
+                    # wait up to 40 ms for a delayed ACK on messages over one segment (Nagle)
+                    _ip("-n", ns, "route", "replace", "%s.0/24" % SUBNET, "dev", "eth0", "quickack", "1")
                 if netem and not userspace:
                     tc = subprocess.run(["ip", "netns", "exec", ns, "tc", "qdisc", "add", "dev", "eth0", "root",
                                          "netem"] + netem.split(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -425,9 +433,10 @@ def run(args):
     run_dir = os.path.abspath(args.run_dir or os.path.join(
         ROOT, "out", "runs", "%s-hosts%d%s" % (scenario.name, args.hosts, "-netem" if netem else "")))
     kernel_netem = check_allowed(netem)
-    hosts = Hosts(args.hosts, prefix="mbot%d" % os.getpid())
+    hosts = Hosts(args.hosts, prefix="mbot%d" % os.getpid(), quickack=not args.no_quickack)
     names = {k: hosts.name(k) for k in placement}
-    say("%s on %d hosts (%s): %s" % (scenario.name, args.hosts, "link: netem " + netem if netem else "no netem",
+    link = ("link: netem " + netem if netem else "no netem") + ("" if hosts.quickack else ", no quickack")
+    say("%s on %d hosts (%s): %s" % (scenario.name, args.hosts, link,
                                      "; ".join("%s %s: %s" % (names[k], hosts.address(k), ", ".join(placement[k]))
                                                for k in sorted(placement))))
     runner = None
@@ -522,6 +531,7 @@ def run(args):
 def write_hosts_json(run_dir, scenario, hosts, placement, netem, master_uri, link):
     with open(os.path.join(run_dir, "hosts.json"), "w") as f:
         json.dump({"scenario": scenario.name, "master": master_uri, "netem": netem or "", "link": link,
+                   "quickack": hosts.quickack,
                    "namespaces": hosts.namespaces(),
                    "hosts": [{"name": hosts.name(k), "address": hosts.address(k), "robots": placement[k],
                               "runs": "master, simulator, map server, tf relay, coordinator, metrics, its robots"
@@ -587,6 +597,7 @@ def parse_args(argv):
     p.add_argument("count", type=int)
     p.add_argument("--netem", action="store_true", help="a Wi-Fi-like link: tc netem " + NETEM)
     p.add_argument("--netem-spec", default=NETEM, help="tc netem's parameters (default: %(default)s)")
+    p.add_argument("--no-quickack", action="store_true", help=NO_QUICKACK)
     sub.add_parser("down", help="remove the hosts `up` made")
     p = sub.add_parser("run", help="run a formation scenario with its robots spread over K hosts")
     p.add_argument("scenario", help="a name (scenarios/NAME.yaml of mbot_bringup) or a path")
@@ -597,6 +608,7 @@ def parse_args(argv):
     p.add_argument("--no-rviz", action="store_true")
     p.add_argument("--no-record", action="store_true")
     p.add_argument("--real-time", action="store_true")
+    p.add_argument("--no-quickack", action="store_true", help=NO_QUICKACK)
     p = sub.add_parser("_stack")       # inside a host: its robots (run starts it)
     for name in ("--master", "--robots", "--localization", "--controller", "--leader-max-vel", "--lockstep"):
         p.add_argument(name, required=True)
@@ -625,7 +637,7 @@ def main(argv=None):
             kernel_netem = check_allowed(netem)
             if netem and not kernel_netem:
                 say(NO_NETEM)
-            hosts = Hosts(args.count)
+            hosts = Hosts(args.count, quickack=not args.no_quickack)
             hosts.up(netem, kernel_netem)
             for k in range(1, args.count + 1):
                 print("%s\t%s\tip netns exec %s ..." % (hosts.name(k), hosts.address(k), hosts.ns(k)))
