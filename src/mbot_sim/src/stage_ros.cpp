@@ -66,6 +66,9 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   pnh.param("lockstep_pacer_lag", p.lockstep_pacer_lag, 0.3);
   if (!(p.lockstep_pacer_lag > 0.0))
     throw StartupError(pnh.resolveName("lockstep_pacer_lag") + ": expected a number > 0 [s]");
+  pnh.param("lockstep_localization_postdate", p.lockstep_localization_postdate, 0.1);
+  if (!(p.lockstep_localization_postdate >= 0.0))
+    throw StartupError(pnh.resolveName("lockstep_localization_postdate") + ": expected a number >= 0 [s]");
   pnh.param("lockstep_localization_lag", p.lockstep_localization_lag, 0.1);
   if (!(p.lockstep_localization_lag >= 0.0))
     throw StartupError(pnh.resolveName("lockstep_localization_lag") + ": expected a number >= 0 [s]");

@@ -101,7 +101,8 @@ bool StageRos::waitForControllers()
           if (!localized(*io))
           {
             late += (late.empty() ? "" : ", ") + io->name + " (localization " +
-                    std::to_string(world_->time() - io->localization_stamp) + " s behind)";
+                    std::to_string(world_->time() - (io->localization_stamp - params_.lockstep_localization_postdate)) +
+                    " s behind)";
             io->localization_ignored = true;
           }
         }
@@ -138,7 +139,12 @@ bool StageRos::waitForControllers()
 /// Lockstep: this robot's localization is at most ~lockstep_localization_lag behind sim time.
 bool StageRos::localizationCurrent(const RobotIo& io) const
 {
-  return io.localization_stamp + params_.lockstep_localization_lag >= world_->time() - 1e-9;
+  // A localization stamps map -> odom with the time of its data plus its transform_tolerance (as
+  // amcl), so that lookups a little newer than its last update succeed. What it has processed is
+  // the stamp without that: waiting on the stamp itself let sim time run up to the tolerance
+  // further ahead of a slow localization, and the followers then found poses too old.
+  return io.localization_stamp - params_.lockstep_localization_postdate + params_.lockstep_localization_lag >=
+         world_->time() - 1e-9;
 }
 
 /// Lockstep: the newest stamp of each robot's localization output, a transform to <ns>/odom.

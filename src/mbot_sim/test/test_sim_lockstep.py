@@ -168,14 +168,15 @@ class SimLockstep(unittest.TestCase):
     def test_slow_localization_holds_sim_time_and_release(self):
         period, step = sim_settings()
         lag = rospy.get_param("/stage_node/lockstep_localization_lag")
-        limit = lag + period + step + 1e-6
+        postdate = rospy.get_param("/stage_node/lockstep_localization_postdate")
+        limit = lag + period + step + 1e-6  # past the time of the localization's data, not its stamp
         watch = ClockWatch(limit)
         pub = rospy.Publisher("/tf", TFMessage, queue_size=10, tcp_nodelay=True)
         wait_for(lambda: pub.get_num_connections() > 0 and watch.now() is not None, 20.0, "stage_node")
 
-        def publish(stamp):
+        def publish(stamp):  # data of time `stamp`, post-dated as amcl does
             t = TransformStamped()
-            t.header.stamp = rospy.Time.from_sec(stamp)
+            t.header.stamp = rospy.Time.from_sec(stamp + postdate)
             t.header.frame_id = "map"
             t.child_frame_id = "robot_1/odom"
             t.transform.rotation.w = 1.0
@@ -187,7 +188,7 @@ class SimLockstep(unittest.TestCase):
               "(allowed %.3f s)" % (sim_run, wall_run, ANSWERS, worst, limit))
         self.assertEqual(len(violations), 0, "sim time ran ahead of the localization (stamp, sim time): %s"
                          % violations[:5])
-        # Each transform releases sim time up to the first boundary more than `lag` past its stamp.
+        # Each transform releases sim time up to the first boundary more than `lag` past its data (stamp - postdate).
         self.assertLess(sim_run, ANSWERS * limit + limit)
         wait_for_release(watch, "the localization")
 

@@ -55,20 +55,22 @@ struct StageParams
   bool has_real_time_factor = false;
   double real_time_factor = 1.0;  ///< ~real_time_factor: overrides the world file's when set
   bool has_seed = false;
-  int seed = 0;                            ///< ~seed: overrides the world file's when set
-  double watchdog_timeout = 0.2;           ///< ~base_watchdog_timeout [s sim time]
-  double marker_rate = 10.0;               ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
-  double wheel_tf_rate = 10.0;             ///< ~wheel_tf_rate: <ns>/base_link -> <ns>/<wheel> on /tf [Hz sim
-                                           ///< time]; 0: not published (robot_state_publisher from joint_states)
-  bool lockstep = false;                   ///< ~lockstep: hold sim time at period boundaries for the controllers
-  double lockstep_period = 0.05;           ///< ~lockstep_period: distance of the boundaries [s sim time]
-  double lockstep_active_timeout = 0.5;    ///< ~lockstep_active_timeout: a robot is driven while its
-                                           ///< last cmd_vel is at most this old [s sim time]
-  double lockstep_wall_timeout = 2.0;      ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
-  double lockstep_localization_lag = 0.1;  ///< ~lockstep_localization_lag: each robot's localization
-                                           ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
-  double lockstep_pacer_lag = 0.3;         ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
-                                           ///< /lockstep/heartbeat) may lag it this much [s sim]
+  int seed = 0;                                 ///< ~seed: overrides the world file's when set
+  double watchdog_timeout = 0.2;                ///< ~base_watchdog_timeout [s sim time]
+  double marker_rate = 10.0;                    ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+  double wheel_tf_rate = 10.0;                  ///< ~wheel_tf_rate: <ns>/base_link -> <ns>/<wheel> on /tf [Hz sim
+                                                ///< time]; 0: not published (robot_state_publisher from joint_states)
+  bool lockstep = false;                        ///< ~lockstep: hold sim time at period boundaries for the controllers
+  double lockstep_period = 0.05;                ///< ~lockstep_period: distance of the boundaries [s sim time]
+  double lockstep_active_timeout = 0.5;         ///< ~lockstep_active_timeout: a robot is driven while its
+                                                ///< last cmd_vel is at most this old [s sim time]
+  double lockstep_wall_timeout = 2.0;           ///< ~lockstep_wall_timeout: longest wait at a boundary [s wall]
+  double lockstep_localization_lag = 0.1;       ///< ~lockstep_localization_lag: each robot's localization
+                                                ///< (map -> <ns>/odom on /tf) may lag sim time this much [s sim]
+  double lockstep_localization_postdate = 0.1;  ///< ~lockstep_localization_postdate: the localizations post-date
+                                                ///< map -> <ns>/odom by this much (their transform_tolerance) [s]
+  double lockstep_pacer_lag = 0.3;              ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
+                                                ///< /lockstep/heartbeat) may lag it this much [s sim]
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
