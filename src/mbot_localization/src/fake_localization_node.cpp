@@ -5,20 +5,19 @@
  *        fake_localization does.
  *
  * Subscribes `odom` and `base_pose_ground_truth` (nav_msgs/Odometry); publishes tf
- * `map -> <ns>/odom` for every odometry message, or at most ~tf_publish_rate times per sim second
- * (0: no limit, the default; amcl publishes at its laser's rate), post-dated by
- * ~transform_tolerance as amcl and fake_localization do, and
+ * `map -> <ns>/odom` at most ~tf_publish_rate times per sim second (10 Hz; 0: for every odometry
+ * message), post-dated by ~transform_tolerance as amcl and fake_localization do, and
  * `amcl_pose` (PoseWithCovarianceStamped) and `particlecloud` (PoseArray, one pose) for every
  * odometry message. Parameters: ~robot (default: the namespace), ~global_frame_id (map),
  * ~odom_frame_id (<robot>/odom), ~base_frame_id (<robot>/base_footprint),
- * ~transform_tolerance (0.1 s), ~tf_publish_rate (0). Sim time only: the ground truth
+ * ~transform_tolerance (0.1 s), ~tf_publish_rate (10 Hz). Sim time only: the ground truth
  * exists only in simulation.
  *
- * Why a limit: /tf goes to every tf listener of the fleet, and at 50 Hz per robot the
- * localizations' transforms are most of its messages. Why none by default: the simulator's lockstep
- * does not wait for a post-dated transform, so on a loaded machine a limited one came late now and
- * then, and the followers, which refuse a pose 0.1 s old, missed lookups (10 Hz: tf success 0.9979
- * in the demo test and the triangle_trio scenario rostest, under the lab's 0.998).
+ * Why a limit: /tf goes to every tf listener of the fleet, and at the odometry rate (50 Hz per
+ * robot) the localizations' transforms were most of its messages. A transform post-dated by
+ * 0.1 s every 0.1 s covers every lookup up to the next one, as amcl's at its laser's rate; the
+ * simulator's lockstep waits on the time of the data (the stamp less the post-dating), so a
+ * slow localization holds sim time instead of leaving the followers with old poses.
  */
 #include <cmath>
 #include <cstdint>
@@ -50,7 +49,7 @@ public:
     odom_frame_ = params.getString("odom_frame_id", prefixedFrame(robot, "odom"));
     base_frame_ = params.getString("base_frame_id", prefixedFrame(robot, "base_footprint"));
     transform_tolerance_ = ros::Duration(params.getDouble("transform_tolerance", 0.1));
-    const double rate = params.getDouble("tf_publish_rate", 0.0);
+    const double rate = params.getDouble("tf_publish_rate", 10.0);
     if (!(rate >= 0.0) || !std::isfinite(rate))
       throw std::runtime_error(pnh.resolveName("tf_publish_rate") + ": expected a number >= 0 [Hz], got " +
                                std::to_string(rate));
