@@ -19,8 +19,8 @@ def launch_files(*args):
     """`roslaunch --files mbot_navigation fleet_navigation.launch ARGS` with mbot_sim off the
     package path; (exit status, output)."""
     without_sim = 'echo "$ROS_PACKAGE_PATH" | tr : "\\n" | grep -v /mbot_sim | paste -sd:'
-    script = ('. "%s" && export ROS_PACKAGE_PATH="$(%s)" && roslaunch --files mbot_navigation fleet_navigation.launch %s'
-              % (SETUP, without_sim, " ".join(args)))
+    script = ('. "%s" && export ROS_PACKAGE_PATH="$(%s)" && roslaunch --files mbot_navigation '
+              'fleet_navigation.launch %s' % (SETUP, without_sim, " ".join(args)))
     env = dict(os.environ, ROS_HOME=tempfile.mkdtemp(prefix="ros_home_"), PATH="/usr/bin:/bin:" + os.environ["PATH"])
     result = subprocess.run(["bash", "-c", script], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             universal_newlines=True, timeout=60, env=env)
