@@ -63,8 +63,11 @@ public:
 
     pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
     cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
-    odom_sub_ = nh.subscribe("odom", 20, &FakeLocalizationNode::onOdometry, this);
-    truth_sub_ = nh.subscribe("base_pose_ground_truth", 20, &FakeLocalizationNode::onGroundTruth, this);
+    // TCP_NODELAY: without it a message that spans TCP segments waits for the receiver's delayed
+    // ACK (Nagle), up to 40 ms between hosts: the fleet's map -> odom came late across machines.
+    const ros::TransportHints no_delay = ros::TransportHints().tcpNoDelay();
+    odom_sub_ = nh.subscribe("odom", 20, &FakeLocalizationNode::onOdometry, this, no_delay);
+    truth_sub_ = nh.subscribe("base_pose_ground_truth", 20, &FakeLocalizationNode::onGroundTruth, this, no_delay);
     ROS_INFO("fake_localization: %s -> %s from %s and %s", global_frame_.c_str(), odom_frame_.c_str(),
              truth_sub_.getTopic().c_str(), odom_sub_.getTopic().c_str());
   }

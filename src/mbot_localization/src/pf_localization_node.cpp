@@ -46,7 +46,7 @@ public:
     // As amcl: a scan is handed on once tf can place it in the odom frame at its stamp. Waiting
     // for that inside the callback would sleep in sim time, and under the simulator's lockstep
     // sim time waits for this node: both would wait until the simulator gives up.
-    scan_sub_.subscribe(nh, "scan", 5);
+    scan_sub_.subscribe(nh, "scan", 5, ros::TransportHints().tcpNoDelay());  // no Nagle wait (fake_localization)
     scan_filter_ =
         std::make_unique<tf2_ros::MessageFilter<sensor_msgs::LaserScan>>(scan_sub_, tf_buffer_, odom_frame_, 10, nh);
     scan_filter_->registerCallback(&PfLocalizationNode::onScan, this);
