@@ -29,6 +29,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 SUBNET = "10.77.0"                 # host k: SUBNET.k/24
@@ -513,8 +514,13 @@ def run(args):
     finally:
         if runner is not None:   # interrupted: the runner stops its launch on SIGINT
             stop(runner, "the scenario runner", waits=((signal.SIGINT, 120.0), (signal.SIGTERM, 15.0)), group=True)
-        for k, process in sorted(stacks.items()):
-            stop(process, "host %d's robots" % k)
+        # all hosts at once: each roslaunch takes its time to stop its nodes once the master is gone
+        stopping = [threading.Thread(target=stop, args=(process, "host %d's robots" % k))
+                    for k, process in sorted(stacks.items())]
+        for thread in stopping:
+            thread.start()
+        for thread in stopping:
+            thread.join()
         if recorder is not None and recorder.poll() is None:
             stop(recorder, "the node recorder", waits=((signal.SIGTERM, 5.0),))
         hosts.down()
