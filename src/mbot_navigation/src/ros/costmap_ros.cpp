@@ -434,7 +434,7 @@ void toOccupancyGrid(const Costmap2D& costmap, nav_msgs::OccupancyGrid& grid)
 
 CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settings, ros::NodeHandle& nh,
                        ros::NodeHandle& private_nh, tf2_ros::Buffer& tf)
-    : name_(name), settings_(settings), tf_(tf)
+    : name_(name), settings_(settings), nh_(nh), tf_(tf)
 {
   layered_ = std::make_unique<LayeredCostmap>(settings.costmap);
   // Bottom to top as configured; the default puts inflation last, so that it inflates everything
@@ -473,11 +473,45 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
 
   // As costmap_2d: a relative map_topic is in the robot's namespace (ours default to "/map").
   if (static_layer_) map_sub_ = nh.subscribe(settings.map_topic, 1, &CostmapRos::mapCallback, this);
-  if (obstacle_layer_ || moving_layer_)
-    scan_sub_ = nh.subscribe(settings.scan_topic, 10, &CostmapRos::scanCallback, this);
+  subscribeScans();
+  // Not latched: a new subscriber gets the current grid from onSubscriber(), and nobody pays for
+  // grids that nobody reads.
   if (settings.publish_frequency > 0.0)
-    costmap_pub_ = private_nh.advertise<nav_msgs::OccupancyGrid>(name + "/costmap", 1, true);
+    costmap_pub_ = private_nh.advertise<nav_msgs::OccupancyGrid>(
+        name + "/costmap", 1, [this](const ros::SingleSubscriberPublisher& pub) { onSubscriber(pub); });
   grid_msg_.header.frame_id = settings.global_frame;
+}
+
+void CostmapRos::subscribeScans()
+{
+  if (obstacle_layer_ || moving_layer_)
+    scan_sub_ = nh_.subscribe(settings_.scan_topic, 10, &CostmapRos::scanCallback, this);
+}
+
+void CostmapRos::stop()
+{
+  scan_sub_.shutdown();
+  pending_scans_.clear();
+  teammates_.clear();
+  stopped_ = true;
+}
+
+void CostmapRos::start()
+{
+  if (!stopped_) return;
+  subscribeScans();
+  resetLayers();  // marks from before the stop are where things were then
+  warming_ = obstacle_layer_ || moving_layer_;
+  stopped_ = false;
+}
+
+void CostmapRos::resetLayers()
+{
+  layered_->reset();
+  next_update_ = ros::Time(0);
+  if (!stopped_ || !updated_) return;
+  if (robots_layer_) robots_layer_->setTeammates({});
+  layered_->updateMap(last_robot_);
 }
 
 void CostmapRos::mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& map)
@@ -562,6 +596,7 @@ void CostmapRos::applyScans(const ros::Time& now)
     obs = withoutTeammateHits(obs, teammates_, settings_.robots_scan_margin);
     if (obstacle_layer_) obstacle_layer_->addObservation(obs);
     if (moving_layer_) moving_layer_->addObservation(obs);
+    warming_ = false;
   }
   pending_scans_.swap(keep);
 }
@@ -574,24 +609,36 @@ void CostmapRos::update(const Pose2D& robot, const ros::Time& now)
                                                   settings_.costmap.resolution, settings_.robots_padding));
   layered_->updateMap(robot);
   next_update_ = now + ros::Duration(1.0 / settings_.update_frequency);
+  last_robot_ = robot;
+  updated_ = true;
 }
 
 void CostmapRos::publishIfDue(const ros::Time& now)
 {
   if (settings_.publish_frequency <= 0.0 || now < next_publish_ || !ready()) return;
   next_publish_ = now + ros::Duration(1.0 / settings_.publish_frequency);
+  if (costmap_pub_.getNumSubscribers() == 0) return;
   grid_msg_.header.stamp = now;
   toOccupancyGrid(costmap(), grid_msg_);
   grid_msg_.info.map_load_time = now;
   costmap_pub_.publish(grid_msg_);
 }
 
+void CostmapRos::onSubscriber(const ros::SingleSubscriberPublisher& pub)
+{
+  if (!ready()) return;  // publishIfDue() sends the first grid
+  const ros::Time now = ros::Time::now();
+  grid_msg_.header.stamp = now;
+  toOccupancyGrid(costmap(), grid_msg_);
+  grid_msg_.info.map_load_time = now;
+  pub.publish(grid_msg_);
+}
+
 void CostmapRos::clear()
 {
   // Every layer forgets what it sensed (the static layer keeps its map and rewrites it), and the
-  // whole master grid is rewritten at the next update.
-  layered_->reset();
-  next_update_ = ros::Time(0);
+  // whole master grid is rewritten.
+  resetLayers();
 }
 
 void CostmapRos::setInflation(const InflationLayerConfig& config)

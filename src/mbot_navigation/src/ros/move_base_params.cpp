@@ -16,8 +16,8 @@ namespace
 {
 // Standard keys this node does not implement (docs/move_base_keys.md), by namespace.
 const std::vector<std::string> kIgnoredMoveBaseKeys = {
-    "recovery_behaviors", "conservative_reset_dist", "shutdown_costmaps", "max_planning_retries",
-    "make_plan_clear_costmap", "make_plan_add_unreachable_goal", "restore_defaults",
+    "recovery_behaviors", "conservative_reset_dist", "max_planning_retries", "make_plan_clear_costmap",
+    "make_plan_add_unreachable_goal", "restore_defaults",
     // the namespaces of move_base's default recoveries, and of a planner this node does not have
     "conservative_reset", "rotate_recovery", "aggressive_reset", "CarrotPlanner"};
 const std::vector<std::string> kIgnoredNavfnKeys = {"default_tolerance", "visualize_potential", "planner_window_x",
@@ -392,6 +392,7 @@ NavParams readNavParams(const ros::NodeHandle& nh, const ros::NodeHandle& privat
   nav.oscillation_distance = p.getDouble("oscillation_distance", nav.oscillation_distance);
   nav.recovery_behavior_enabled = p.getBool("recovery_behavior_enabled", nav.recovery_behavior_enabled);
   out.clearing_rotation_allowed = p.getBool("clearing_rotation_allowed", true);
+  out.shutdown_costmaps = p.getBool("shutdown_costmaps", false);
   out.back_up.distance = p.getDouble("back_up_distance", out.back_up.distance);
   out.back_up.speed = p.getDouble("back_up_speed", out.back_up.speed);
   require(out.back_up.distance >= 0.0, private_nh, "back_up_distance", "a number >= 0 [m] (0: no backing up)");

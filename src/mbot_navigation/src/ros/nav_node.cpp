@@ -11,6 +11,7 @@
 
 #include <mbot_common/ros_edge.h>
 #include "mbot_navigation/ros/move_base_params.h"
+#include "mbot_navigation/ros/shared_tf.h"
 #include "mbot_navigation/global_planner/goal_tolerance.h"
 #include "mbot_navigation/global_planner/planner_factory.h"
 #include "mbot_navigation/local_planner/dwa_planner.h"
@@ -28,6 +29,19 @@ geometry_msgs::PoseStamped toPoseStamped(const Pose2D& p, const std::string& fra
   out.header.stamp = stamp;
   out.pose = mbot_common::toPoseMsg(p);
   return out;
+}
+
+GoalValues goalValues(const geometry_msgs::Pose& p)
+{
+  GoalValues v;
+  v.x = p.position.x;
+  v.y = p.position.y;
+  v.z = p.position.z;
+  v.qx = p.orientation.x;
+  v.qy = p.orientation.y;
+  v.qz = p.orientation.z;
+  v.qw = p.orientation.w;
+  return v;
 }
 }  // namespace
 
@@ -65,8 +79,8 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   }
 
   // --- the parts
-  tf_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(10.0));
-  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_);
+  tf_ = SharedTf::buffer();
+  tf_listener_ = SharedTf::listen();
   global_costmap_ = std::make_unique<CostmapRos>("global_costmap", global_settings, nh_, private_nh_, *tf_);
   local_costmap_ = std::make_unique<CostmapRos>("local_costmap", local_settings, nh_, private_nh_, *tf_);
 
@@ -93,11 +107,12 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
                                            std::move(recoveries));
 
   teammates_ = std::make_unique<TeammateTracker>(
-      *tf_, robot_, global_frame_,
+      nh_, *tf_, robot_, global_frame_,
       params.robots_source == "odom" ? TeammateTracker::Source::ODOM : TeammateTracker::Source::GROUND_TRUTH,
       params.robots, params.robots_timeout, TeammateRadii(description_dir, params.model, params.footprint_radius));
   if (params.robots.empty())
   {
+    // Cheap: a cached parameter (the master is asked only without the simulator; discover()).
     teammates_->discover();
     discovery_timer_ =
         nh_.createWallTimer(ros::WallDuration(2.0), [this](const ros::WallTimerEvent&) { teammates_->discover(); });
@@ -109,27 +124,30 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   local_plan_pub_ = private_nh_.advertise<nav_msgs::Path>("local_plan", 1);
   action_goal_pub_ = nh_.advertise<move_base_msgs::MoveBaseActionGoal>("move_base/goal", 1);
   simple_goal_sub_ = nh_.subscribe("move_base_simple/goal", 1, &NavNode::onSimpleGoal, this);
-  odom_sub_ = nh_.subscribe(params.odom_topic, 1, &NavNode::onOdom, this);
+  odom_topic_ = params.odom_topic;
+  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this);
   make_plan_srv_ = private_nh_.advertiseService("make_plan", &NavNode::onMakePlan, this);
   clear_costmaps_srv_ = private_nh_.advertiseService("clear_costmaps", &NavNode::onClearCostmaps, this);
   server_ = std::make_unique<ActionServer>(nh_, "move_base", false);
   // No goal callback: the control cycle accepts new goals (see nav_node.h).
   server_->registerPreemptCallback([this]() { onPreempt(); });
   control_period_ = 1.0 / controller_frequency;
+  shutdown_costmaps_ = params.shutdown_costmaps;
   cycle_timer_ = nh_.createTimer(ros::Duration(control_period_), &NavNode::cycle, this);
   startReconfigureServers();
 
   ROS_INFO(
-      "%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s; "
+      "%s: robot '%s' (model %s, radius %.2f m), global planner %s, DWA at %.0f Hz, frames %s -> %s%s; "
       "waiting for the map and the robot's pose",
       private_nh_.getNamespace().c_str(), robot_.c_str(), params.model.c_str(), params.footprint_radius,
-      global_planner_name.c_str(), controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str());
+      global_planner_name.c_str(), controller_frequency, global_frame_.c_str(), robot_base_frame_.c_str(),
+      shutdown_costmaps_ ? ", costmaps shut down while idle" : "");
 }
 
 // =============================================================================================
 // NavNode: the control cycle
 
-bool NavNode::robotPose(Pose2D& pose, std::string& error, ros::Time* stamp) const
+bool NavNode::robotPose(Pose2D& pose, std::string& error, ros::Time* stamp, bool wait) const
 {
   // Under load this node's tf listener can fall behind /clock. Wait a little for the pose of one
   // control period ago rather than steer on an older one: at most one period of sim time, and at
@@ -138,7 +156,7 @@ bool NavNode::robotPose(Pose2D& pose, std::string& error, ros::Time* stamp) cons
   const ros::Time start = ros::Time::now();
   const ros::Time wanted = start - ros::Duration(control_period_);
   const ros::WallTime wall_deadline = ros::WallTime::now() + ros::WallDuration(0.1);
-  while (wanted.toSec() > 0.0 && !tf_->canTransform(global_frame_, robot_base_frame_, wanted) &&
+  while (wait && wanted.toSec() > 0.0 && !tf_->canTransform(global_frame_, robot_base_frame_, wanted) &&
          (ros::Time::now() - start).toSec() < control_period_ && ros::WallTime::now() < wall_deadline && ros::ok())
     ros::WallDuration(0.0005).sleep();
   geometry_msgs::TransformStamped t;
@@ -168,11 +186,28 @@ void NavNode::cycle(const ros::TimerEvent&)
 {
   const ros::Time now = ros::Time::now();
   if (now.isZero()) return;  // no /clock yet
+  if (global_costmap_->mapCount() != goal_checker_map_count_)
+  {
+    goal_checker_.setCostmap(global_costmap_->staticCostmap());
+    goal_checker_map_count_ = global_costmap_->mapCount();
+  }
+  if (asleep_)
+  {
+    if (!server_->isNewGoalAvailable()) return;
+    acceptGoal(false);  // a goal that is bad without tf is rejected at once, and the node sleeps on
+    if (!has_pending_goal_) return;
+    publishZero();  // as move_base at a new goal; under lockstep, sim time now waits for this node
+    wake();
+  }
 
+  // Only a robot about to steer waits for a fresh pose (a woken one: for tf to come back); an idle
+  // one takes the latest.
+  const bool steering =
+      navigator_->state() != NavState::IDLE || has_pending_goal_ || (server_started_ && server_->isNewGoalAvailable());
   Pose2D pose;
   std::string pose_error;
   ros::Time pose_stamp;
-  const bool has_pose = robotPose(pose, pose_error, &pose_stamp);
+  const bool has_pose = robotPose(pose, pose_error, &pose_stamp, steering);
   if (has_pose)
   {
     last_pose_time_ = now;
@@ -183,11 +218,6 @@ void NavNode::cycle(const ros::TimerEvent&)
       if (costmap->updateDue(now) && costmap->ready()) costmap->update(pose, now);
       costmap->publishIfDue(now);
     }
-  }
-  if (global_costmap_->mapCount() != goal_checker_map_count_)
-  {
-    goal_checker_.setCostmap(global_costmap_->staticCostmap());
-    goal_checker_map_count_ = global_costmap_->mapCount();
   }
 
   if (!server_started_)
@@ -204,12 +234,26 @@ void NavNode::cycle(const ros::TimerEvent&)
              nh_.resolveName("move_base").c_str());
   }
 
-  if (server_->isNewGoalAvailable()) acceptGoal();
+  if (server_->isNewGoalAvailable())
+    acceptGoal(readyForGoal(has_pose));
+  else if (has_pending_goal_ && readyForGoal(has_pose))
+  {
+    ROS_INFO("%s: woken for a goal %.2f s ago (wall): %s", private_nh_.getNamespace().c_str(),
+             (ros::WallTime::now() - woken_at_).toSec(), has_pose ? "robot pose known" : "no robot pose yet");
+    startPendingGoal();
+  }
+  if (has_pending_goal_)
+  {
+    publishZero();  // woken for it, waiting for tf
+    was_active_ = true;
+    return;
+  }
 
   if (navigator_->state() == NavState::IDLE)
   {
     if (was_active_) publishZero();
     was_active_ = false;
+    if (shutdown_costmaps_ && !server_->isNewGoalAvailable()) sleep();
     return;
   }
   was_active_ = true;
@@ -240,8 +284,8 @@ void NavNode::cycle(const ros::TimerEvent&)
   cmd.linear.y = result.cmd.vy;
   cmd.angular.z = result.cmd.wz;
   cmd_vel_pub_.publish(cmd);
-  if (result.plan_updated) publishPath(global_plan_pub_, navigator_->globalPlan(), now);
-  publishPath(local_plan_pub_, navigator_->localPlan().poses, now);
+  if (result.plan_updated) publishPath(global_plan_pub_, navigator_->globalPlan(), now);  // latched: always
+  if (local_plan_pub_.getNumSubscribers() > 0) publishPath(local_plan_pub_, navigator_->localPlan().poses, now);
 
   switch (result.outcome)
   {
@@ -263,6 +307,49 @@ void NavNode::cycle(const ros::TimerEvent&)
     case NavOutcome::NONE: break;
   }
 }
+
+// =============================================================================================
+// NavNode: sleeping while idle (shutdown_costmaps)
+
+void NavNode::sleep()
+{
+  global_costmap_->stop();
+  local_costmap_->stop();
+  teammates_->stop();
+  discovery_timer_.stop();
+  odom_sub_.shutdown();
+  tf_listener_.reset();  // the last one in the process stops the listener (shared_tf.h)
+  asleep_ = true;
+  ROS_DEBUG("%s: no goal: costmaps shut down", private_nh_.getNamespace().c_str());
+}
+
+void NavNode::wake()
+{
+  if (!asleep_) return;
+  tf_listener_ = SharedTf::listen();
+  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this);
+  velocity_ = Twist2D();  // until the odometry comes
+  teammates_->start();
+  if (discovery_timer_.isValid())
+  {
+    teammates_->discover();
+    discovery_timer_.start();
+  }
+  global_costmap_->start();
+  local_costmap_->start();
+  woken_at_ = ros::WallTime::now();
+  asleep_ = false;
+  ROS_DEBUG("%s: costmaps started", private_nh_.getNamespace().c_str());
+}
+
+bool NavNode::readyForGoal(bool has_pose) const
+{
+  // Never woken (always awake): long ago.
+  return has_pose || (ros::WallTime::now() - woken_at_).toSec() >= kWakeTimeout;
+}
+
+// =============================================================================================
+// NavNode: live tuning
 
 void NavNode::startReconfigureServers()
 {
@@ -370,15 +457,7 @@ std::string NavNode::goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, P
 
 std::string NavNode::checkGoal(const geometry_msgs::PoseStamped& goal, Pose2D& out)
 {
-  GoalValues values;
-  values.x = goal.pose.position.x;
-  values.y = goal.pose.position.y;
-  values.z = goal.pose.position.z;
-  values.qx = goal.pose.orientation.x;
-  values.qy = goal.pose.orientation.y;
-  values.qz = goal.pose.orientation.z;
-  values.qw = goal.pose.orientation.w;
-  std::string error = checkGoalValues(values);
+  std::string error = checkGoalValues(goalValues(goal.pose));
   if (error.empty()) error = goalToGlobalFrame(goal, out);
   if (!error.empty()) return error;
   Pose2D robot;
@@ -387,10 +466,11 @@ std::string NavNode::checkGoal(const geometry_msgs::PoseStamped& goal, Pose2D& o
   return goal_checker_.check(has_pose ? &robot : nullptr, out);
 }
 
-void NavNode::acceptGoal()
+void NavNode::acceptGoal(bool ready)
 {
   const move_base_msgs::MoveBaseGoal::ConstPtr goal = server_->acceptNewGoal();
   if (!goal) return;
+  has_pending_goal_ = false;
   if (server_->isPreemptRequested())
   {
     // Cancelled before this cycle accepted it: the preempt callback only fires for an accepted
@@ -401,14 +481,28 @@ void NavNode::acceptGoal()
     ROS_INFO("%s: goal cancelled before it was accepted", private_nh_.getNamespace().c_str());
     return;
   }
+  pending_goal_ = goal->target_pose;
+  has_pending_goal_ = true;
+  if (ready)
+  {
+    startPendingGoal();
+    return;
+  }
+  // Just woken, tf is not back yet: reject now what needs no tf.
+  std::string error = checkGoalValues(goalValues(pending_goal_.pose));
+  if (error.empty() && pending_goal_.header.frame_id == global_frame_)
+    error = goal_checker_.check(nullptr, mbot_common::toPose2D(pending_goal_.pose));
+  if (!error.empty()) rejectGoal(error);
+}
+
+void NavNode::startPendingGoal()
+{
+  has_pending_goal_ = false;
   Pose2D target;
-  const std::string error = checkGoal(goal->target_pose, target);
+  const std::string error = checkGoal(pending_goal_, target);
   if (!error.empty())
   {
-    navigator_->cancel();
-    publishZero();
-    ROS_WARN("%s: goal rejected: %s", private_nh_.getNamespace().c_str(), error.c_str());
-    server_->setAborted(move_base_msgs::MoveBaseResult(), error);
+    rejectGoal(error);
     return;
   }
   ROS_INFO("%s: new goal (%.2f, %.2f, %.2f rad) in %s", private_nh_.getNamespace().c_str(), target.x, target.y,
@@ -418,10 +512,20 @@ void NavNode::acceptGoal()
   last_pose_time_ = std::max(last_pose_time_, now);  // a missing pose counts from the goal's start
 }
 
+void NavNode::rejectGoal(const std::string& error)
+{
+  has_pending_goal_ = false;
+  navigator_->cancel();
+  publishZero();
+  ROS_WARN("%s: goal rejected: %s", private_nh_.getNamespace().c_str(), error.c_str());
+  server_->setAborted(move_base_msgs::MoveBaseResult(), error);
+}
+
 void NavNode::onPreempt()
 {
   // Called for a cancel and when a new goal arrives (the next cycle accepts it).
   if (!server_->isActive()) return;
+  has_pending_goal_ = false;
   navigator_->cancel();
   publishZero();
   server_->setPreempted(move_base_msgs::MoveBaseResult(), "preempted");
@@ -451,6 +555,19 @@ bool NavNode::onMakePlan(nav_msgs::GetPlan::Request& req, nav_msgs::GetPlan::Res
   }
   Pose2D start, goal;
   std::string error;
+  if (asleep_)
+  {
+    // As move_base, which plans on its stopped costmaps: wake for the call, plan on the map as it
+    // stands at the robot's pose (tf's own thread fills the buffer meanwhile).
+    wake();
+    Pose2D robot;
+    bool has_pose = false;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kWakeTimeout);
+    while (!(has_pose = robotPose(robot, error, nullptr, false)) && ros::WallTime::now() < deadline && ros::ok())
+      ros::WallDuration(0.01).sleep();
+    if (has_pose) global_costmap_->update(robot, ros::Time::now());
+    error.clear();
+  }
   if (req.start.header.frame_id.empty())
   {
     if (!robotPose(start, error)) error = "no robot pose: " + error;

@@ -10,10 +10,11 @@
 
 namespace mbot_navigation
 {
-TeammateTracker::TeammateTracker(tf2_ros::Buffer& tf, const std::string& self, const std::string& global_frame,
-                                 Source source, const std::vector<std::string>& names, double timeout,
-                                 std::function<double(const std::string&)> radius_of)
-    : tf_(tf),
+TeammateTracker::TeammateTracker(const ros::NodeHandle& nh, tf2_ros::Buffer& tf, const std::string& self,
+                                 const std::string& global_frame, Source source, const std::vector<std::string>& names,
+                                 double timeout, std::function<double(const std::string&)> radius_of)
+    : nh_(nh),
+      tf_(tf),
       self_(self),
       global_frame_(global_frame),
       source_(source),
@@ -29,15 +30,54 @@ void TeammateTracker::track(const std::string& name)
   if (mates_.count(name)) return;
   Mate& mate = mates_[name];
   mate.radius = radius_of_(name);
-  ros::NodeHandle root;
-  const std::string topic = "/" + name + (source_ == Source::GROUND_TRUTH ? "/base_pose_ground_truth" : "/odom");
-  mate.sub = root.subscribe<nav_msgs::Odometry>(
-      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; });
-  ROS_INFO("teammate %s: from %s (radius %.2f m)", name.c_str(), topic.c_str(), mate.radius);
+  if (!stopped_) subscribe(name, mate);
+  ROS_INFO("teammate %s: from /%s/%s (radius %.2f m)", name.c_str(), name.c_str(),
+           source_ == Source::GROUND_TRUTH ? "base_pose_ground_truth" : "odom", mate.radius);
 }
 
-void TeammateTracker::discover()
+void TeammateTracker::subscribe(const std::string& name, Mate& mate)
 {
+  const std::string topic = "/" + name + (source_ == Source::GROUND_TRUTH ? "/base_pose_ground_truth" : "/odom");
+  mate.sub = nh_.subscribe<nav_msgs::Odometry>(
+      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; });
+}
+
+void TeammateTracker::stop()
+{
+  for (auto& kv : mates_)
+  {
+    kv.second.sub.shutdown();
+    kv.second.last.reset();
+  }
+  stopped_ = true;
+}
+
+void TeammateTracker::start()
+{
+  if (!stopped_) return;
+  stopped_ = false;
+  for (auto& kv : mates_) subscribe(kv.first, kv.second);
+}
+
+void TeammateTracker::discover(const ros::WallTime& now)
+{
+  // The simulator's list of its robots: a cached parameter, which the master pushes to this
+  // process when it changes, so reading it asks the master nothing.
+  XmlRpc::XmlRpcValue list;
+  if (ros::param::getCached("/stage/robots", list) && list.getType() == XmlRpc::XmlRpcValue::TypeArray)
+  {
+    for (int i = 0; i < list.size(); ++i)
+      if (list[i].getType() == XmlRpc::XmlRpcValue::TypeStruct && list[i].hasMember("name") &&
+          list[i]["name"].getType() == XmlRpc::XmlRpcValue::TypeString)
+      {
+        const std::string name = static_cast<std::string>(list[i]["name"]);
+        if (name != self_) track(name);
+      }
+    return;
+  }
+  // No simulator (a real fleet whose launch set no ~robots): the master's topic list, rarely.
+  if (now < next_topic_poll_) return;
+  next_topic_poll_ = now + ros::WallDuration(kTopicPollPeriod);
   ros::master::V_TopicInfo topics;
   if (!ros::master::getTopics(topics)) return;
   static const std::regex odom_topic("^/([^/]+)/odom$");

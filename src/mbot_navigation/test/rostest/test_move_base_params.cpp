@@ -87,12 +87,13 @@ TEST(MoveBaseParams, TutorialSetLoadsWithNotesOnly)
   EXPECT_EQ(p.dwa.vx_samples, 6);
   EXPECT_DOUBLE_EQ(p.dwa.controller_frequency, 10.0);
   EXPECT_EQ(p.odom_topic, "odom");
+  EXPECT_FALSE(p.shutdown_costmaps);  // the fixture sets it, to false
 
   EXPECT_EQ(report.warnings, std::vector<std::string>{});  // every key is a standard one
   for (const std::string& key :
-       {"/robot_0/move_base/conservative_reset_dist", "/robot_0/move_base/shutdown_costmaps",
-        "/robot_0/move_base/NavfnROS/default_tolerance", "/robot_0/move_base/NavfnROS/visualize_potential",
-        "/robot_0/move_base/DWAPlannerROS/publish_traj_pc", "/robot_0/move_base/DWAPlannerROS/stop_time_buffer",
+       {"/robot_0/move_base/conservative_reset_dist", "/robot_0/move_base/NavfnROS/default_tolerance",
+        "/robot_0/move_base/NavfnROS/visualize_potential", "/robot_0/move_base/DWAPlannerROS/publish_traj_pc",
+        "/robot_0/move_base/DWAPlannerROS/stop_time_buffer",
         "/robot_0/move_base/global_costmap/always_send_full_costmap",
         "/robot_0/move_base/global_costmap/laser_scan_sensor/sensor_frame",
         "/robot_0/move_base/local_costmap/laser_scan_sensor/expected_update_rate",
@@ -103,7 +104,8 @@ TEST(MoveBaseParams, TutorialSetLoadsWithNotesOnly)
   // Implemented keys give no note.
   for (const std::string& key :
        {"/robot_0/move_base/DWAPlannerROS/max_vel_x", "/robot_0/move_base/controller_frequency",
-        "/robot_0/move_base/global_costmap/inflation_radius", "/robot_0/move_base/DWAPlannerROS/controller_frequency"})
+        "/robot_0/move_base/shutdown_costmaps", "/robot_0/move_base/global_costmap/inflation_radius",
+        "/robot_0/move_base/DWAPlannerROS/controller_frequency"})
     EXPECT_FALSE(mentions(report.notes, key)) << key;
 }
 

@@ -77,3 +77,39 @@ def test_launch_file_has_the_map_server_and_one_navigation_per_robot(tmp_path):
     assert len(only.findall("include")) == 2
     with pytest.raises(ValueError, match="localization"):
         fleet_launch_xml(world, localization="amcl")
+
+
+def test_nav_manager_and_shutdown_costmaps_options(tmp_path):
+    world = read_world(write(tmp_path, "three.world.yaml", "map: %s\nrobots:\n" % OFFICE_MAP
+                             + "".join("  - {name: r%d, pose: [%d, 0, 0]}\n" % (i, i) for i in range(3))))
+
+    def parse(**options):
+        root = ET.fromstring(fleet_launch_xml(world, **options))
+        navs = [{a.get("name"): a.get("value") for a in i.findall("arg")} for i in root.findall("include")
+                if i.get("file").endswith("/navigation.launch")]
+        return root.findall("node"), navs
+
+    # Defaults: a process per robot, awake while idle (move_base's defaults).
+    nodes, navs = parse()
+    assert nodes == []
+    assert all("manager" not in a and "shutdown_costmaps" not in a and "required" not in a for a in navs)
+
+    nodes, navs = parse(nav_manager=True, shutdown_costmaps=True)
+    assert [(n.get("pkg"), n.get("type"), n.get("name"), n.get("args"), n.get("required")) for n in nodes] == [
+        ("nodelet", "nodelet", "nav_manager", "manager", "true")]
+    assert {p.get("name"): p.get("value") for p in nodes[0].findall("param")} == {"num_worker_threads": "3"}
+    # A killed loader unloads its robot only: the loaders are not required, the manager is.
+    assert [(a["robot"], a["manager"], a["required"], a["shutdown_costmaps"]) for a in navs] == [
+        (r, "nav_manager", "false", "true") for r in ("r0", "r1", "r2")]
+
+    # One host's share of a fleet: its own manager, named after its first robot.
+    nodes, navs = parse(nav_manager=True, robots=["r2", "r1"])
+    assert [n.get("name") for n in nodes] == ["nav_manager_r2"]
+    assert {p.get("name"): p.get("value") for p in nodes[0].findall("param")} == {"num_worker_threads": "2"}
+    assert [(a["robot"], a["manager"], a["seed"]) for a in navs] == [("r1", "nav_manager_r2", "2"),
+                                                                     ("r2", "nav_manager_r2", "3")]
+
+    with pytest.raises(ValueError, match="shutdown_costmaps: expected True or False, got 'yes'"):
+        fleet_launch_xml(world, shutdown_costmaps="yes")
+    with pytest.raises(ValueError, match="nav_manager: expected True or False, got 1"):
+        fleet_launch_xml(world, nav_manager=1)

@@ -148,6 +148,19 @@ public:
 
   /// @brief True once the map has arrived (always true without a static layer).
   bool ready() const { return !settings_.static_map || map_count_ > 0; }
+
+  /// @brief Stop updating (move_base's shutdown_costmaps): the laser is unsubscribed, what was
+  ///        pending is dropped, and the grid keeps its last state; update() must not be called
+  ///        until start(). The map subscription stays (it is latched: no traffic).
+  void stop();
+  /// @brief Start again after stop(): subscribe the laser and forget what the layers sensed
+  ///        before the stop (the robot may have moved since; the grid shows the map until the
+  ///        next update). Updates come every cycle until a scan has been applied.
+  void start();
+  bool stopped() const { return stopped_; }
+  /// @brief Running and, with a laser, at least one scan applied since start(): the grid shows
+  ///        what the robot sees now (until then only the map and the teammates).
+  bool current() const { return !stopped_ && !warming_; }
   /// @brief Number of maps received so far (the nav node rebuilds its goal checks when it grows).
   unsigned mapCount() const { return map_count_; }
 
@@ -155,14 +168,16 @@ public:
   ///        obstacle and moving obstacles layers, from the next update() on.
   void setTeammates(const std::vector<TeammateState>& teammates);
 
-  /// @brief True when update_frequency says that the next update is due at `now`.
-  bool updateDue(const ros::Time& now) const { return now >= next_update_; }
+  /// @brief True when update_frequency says that the next update is due at `now`, and every
+  ///        cycle after start() until a scan has been applied (see current()).
+  bool updateDue(const ros::Time& now) const { return now >= next_update_ || warming_; }
   /**
    * @brief Apply the scans received since the last update (transformed with tf2 into global_frame
    *        at their stamps) and update the grid around the robot at `robot` (global_frame).
    */
   void update(const Pose2D& robot, const ros::Time& now);
-  /// @brief Publish the grid when publish_frequency says so.
+  /// @brief Publish the grid when publish_frequency says so and someone subscribes (a new
+  ///        subscriber gets the current grid at once, as from costmap_2d).
   void publishIfDue(const ros::Time& now);
 
   /// @brief Forget what the laser and the teammates marked (clear_costmaps); the map stays.
@@ -183,11 +198,18 @@ public:
 private:
   void mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& map);
   void scanCallback(const sensor_msgs::LaserScan::ConstPtr& scan);
+  void subscribeScans();
+  /// The grid to one new subscriber (nobody else gets a copy).
+  void onSubscriber(const ros::SingleSubscriberPublisher& pub);
   /// Transform the pending scans into observations; keep those tf cannot place yet.
   void applyScans(const ros::Time& now);
+  /// Forget what the layers sensed; the grid is redrawn from the map at once when the updates
+  /// are stopped (nobody would redraw it), else at the next update.
+  void resetLayers();
 
   std::string name_;
   CostmapRosSettings settings_;
+  ros::NodeHandle nh_;  ///< the robot's namespace: the scan topic is resolved in it
   tf2_ros::Buffer& tf_;
   std::unique_ptr<LayeredCostmap> layered_;
   // Non-owning views of the layers (owned by layered_); nullptr when off.
@@ -205,6 +227,10 @@ private:
   std::vector<TeammateState> teammates_;
   ros::Time next_update_, next_publish_;
   nav_msgs::OccupancyGrid grid_msg_;  ///< reused
+  bool stopped_ = false;
+  bool warming_ = false;  ///< started, and no scan applied since
+  bool updated_ = false;  ///< update() ran once: last_robot_ is set
+  Pose2D last_robot_;     ///< the robot's pose at the last update()
 };
 
 }  // namespace mbot_navigation

@@ -86,6 +86,7 @@ struct NavParams
   double controller_frequency = 20.0;    ///< [Hz]
   NavigatorConfig nav;
   bool clearing_rotation_allowed = true;
+  bool shutdown_costmaps = false;   ///< stop the costmaps (and what feeds them) while no goal is active
   BackUpRecoveryConfig back_up;     ///< distance, speed (footprint filled by the node)
   double model_min_vel_x = -0.2;    ///< the model's (how fast it may back up) [m/s]
   std::vector<std::string> robots;  ///< teammates; empty: discover

@@ -9,9 +9,10 @@
  *   sub     /<ns>/move_base_simple/goal (PoseStamped: rviz's "2D Nav Goal"; sent on as an action goal)
  *           /<ns>/odom (the robot's velocity), /<ns>/scan, /map, teammates' topics
  *   srv     /<ns>/move_base/make_plan (nav_msgs/GetPlan), /<ns>/move_base/clear_costmaps (std_srvs/Empty)
- *   pub     /<ns>/cmd_vel, /<ns>/move_base/global_plan, /<ns>/move_base/local_plan (nav_msgs/Path),
- *           /<ns>/move_base/global_costmap/costmap, /<ns>/move_base/local_costmap/costmap
- *           (nav_msgs/OccupancyGrid, latched)
+ *   pub     /<ns>/cmd_vel, /<ns>/move_base/global_plan (latched), /<ns>/move_base/local_plan
+ *           (nav_msgs/Path; while someone subscribes), /<ns>/move_base/global_costmap/costmap,
+ *           /<ns>/move_base/local_costmap/costmap (nav_msgs/OccupancyGrid; the current grid to a
+ *           new subscriber, then while someone subscribes)
  * The robot's pose is tf's global_frame -> robot_base_frame (map -> <ns>/base_footprint), latest,
  * no older than global_costmap/transform_tolerance; without it the robot stands still, and after
  * controller_patience the goal is aborted.
@@ -31,10 +32,11 @@
  *   controller_frequency [Hz] 20, planner_frequency [Hz] 0, planner_patience [s] 5,
  *   controller_patience [s] 15, oscillation_timeout [s] 0, oscillation_distance [m] 0.5,
  *   recovery_behavior_enabled (true), clearing_rotation_allowed (true), back_up_distance [m] 0.3,
- *   back_up_speed [m/s] 0.1;
- *   robots (list of teammates' names; default: discovered from the /<name>/odom topics, every
- *   2 s), robots_source ("ground_truth": /<name>/base_pose_ground_truth | "odom": /<name>/odom
- *   for the velocity + tf global_frame -> <name>/base_footprint for the pose), robots_timeout [s] 1,
+ *   back_up_speed [m/s] 0.1, shutdown_costmaps (false; see below);
+ *   robots (list of teammates' names; default: the simulator's /stage/robots, a cached parameter
+ *   looked at every 2 s wall; without it the master's /<name>/odom topics every 10 s),
+ *   robots_source ("ground_truth": /<name>/base_pose_ground_truth | "odom": /<name>/odom for the
+ *   velocity + tf global_frame -> <name>/base_footprint for the pose), robots_timeout [s] 1,
  *   (the costmaps' robots_padding draws them bigger than their footprint);
  *   global_costmap/..., local_costmap/... (costmap_ros.h);
  *   DWAPlannerROS/<key> or <key> (flat) for the DWA settings, with dwa_local_planner's names
@@ -44,6 +46,20 @@
  *   OmplPlanner/<key>: the OMPL planner's (ompl_planner.h OmplConfig).
  * Unknown keys and wrong types stop the node with a message naming the parameter; a standard
  * move_base key that this node does not implement is one warning (docs/move_base_keys.md).
+ *
+ * shutdown_costmaps (move_base's): while no goal is active the node sleeps. The costmaps stop,
+ * and so does everything that only feeds them and the controller: the laser, the teammates'
+ * topics and their discovery, the odometry and the tf listener. What stays is the action server,
+ * move_base_simple/goal, the services and the map. A new goal is accepted at once, and what can
+ * be checked without tf is checked before waking (values, a goal in the global frame off the map
+ * or in a wall: rejected, and the node sleeps on). Then the node wakes and sends zero velocities
+ * until tf gives the robot's pose again (at most kWakeTimeout of wall time: subscribing takes wall
+ * time; meanwhile each cycle waits for tf as a steering one does, so that under lockstep sim time
+ * waits too), checks the rest (other frames, the path from the robot) and drives. The costmaps
+ * update every cycle until their first scan. make_plan wakes the node for the call. When the goal
+ * ends, the node sleeps again.
+ * A sleeping node costs a timer and /clock: an idle robot of a fleet (a formation's follower,
+ * driven by its own controller) does not pay for the whole fleet's /tf and teammates.
  */
 #pragma once
 
@@ -88,7 +104,11 @@ private:
 
   // --- ROS callbacks
   void cycle(const ros::TimerEvent& event);
-  void acceptGoal();
+  /// Take the server's new goal: reject it, or make it the pending goal and start it when `ready`.
+  void acceptGoal(bool ready);
+  /// Check the pending goal with tf and the robot's pose, then drive it or reject it.
+  void startPendingGoal();
+  void rejectGoal(const std::string& error);
   void onPreempt();
   void onSimpleGoal(const geometry_msgs::PoseStamped::ConstPtr& goal);
   void onOdom(const nav_msgs::Odometry::ConstPtr& odom);
@@ -97,8 +117,15 @@ private:
 
   // --- helpers
   /// The robot in the global frame from tf (latest); false and `error` when tf cannot tell.
-  /// `stamp` (when given) is the transform's time.
-  bool robotPose(Pose2D& pose, std::string& error, ros::Time* stamp = nullptr) const;
+  /// `stamp` (when given) is the transform's time. `wait`: give tf a little time to catch up
+  /// (see the definition); an idle node does not wait.
+  bool robotPose(Pose2D& pose, std::string& error, ros::Time* stamp = nullptr, bool wait = true) const;
+  /// shutdown_costmaps: stop (sleep) and start (wake) the costmaps and their inputs.
+  void sleep();
+  void wake();
+  /// tf gives the robot's pose (or it did not come within kWakeTimeout of waking): the pending
+  /// goal can be checked and started.
+  bool readyForGoal(bool has_pose) const;
   /// "" and `out` (global frame) for a usable goal, else the status text that says why not.
   std::string goalToGlobalFrame(const geometry_msgs::PoseStamped& goal, Pose2D& out) const;
   /// Why the goal cannot be taken ("" when it can); `out` is the goal in the global frame.
@@ -112,14 +139,15 @@ private:
 
   ros::NodeHandle nh_, private_nh_;
   std::string robot_;
+  std::string odom_topic_;
   std::string global_frame_, robot_base_frame_;
   double controller_patience_ = 15.0;  ///< also how long a missing robot pose is tolerated [s]
   double transform_tolerance_ = 0.5;   ///< an older robot pose counts as missing [s] (global_costmap's)
   double control_period_ = 0.05;       ///< 1 / controller_frequency [s]
   DwaConfig dwa_config_;               ///< the settings of the local planner in force (a DwaPlanner)
 
-  std::unique_ptr<tf2_ros::Buffer> tf_;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::shared_ptr<tf2_ros::Buffer> tf_;                      ///< the process's (shared_tf.h)
+  std::shared_ptr<tf2_ros::TransformListener> tf_listener_;  ///< held while awake
   std::unique_ptr<CostmapRos> global_costmap_, local_costmap_;
   std::unique_ptr<Navigator> navigator_;
   std::unique_ptr<TeammateTracker> teammates_;
@@ -140,6 +168,16 @@ private:
   Twist2D velocity_;          ///< from the robot's odometry, robot frame
   ros::Time last_pose_time_;  ///< last time tf gave the robot's pose
   bool was_active_ = false;   ///< a goal was being driven in the previous cycle
+
+  bool shutdown_costmaps_ = false;  ///< sleep while no goal is active (see the file comment)
+  bool asleep_ = false;
+  ros::WallTime woken_at_;  ///< of the last wake()
+  /// A woken node starts its goal at the latest this long after wake() [s wall], with or without
+  /// the robot's pose (a tf that never comes must not keep the goal waiting: the goal's own
+  /// no-pose handling takes over).
+  static constexpr double kWakeTimeout = 1.0;
+  bool has_pending_goal_ = false;  ///< accepted, not checked against tf yet
+  geometry_msgs::PoseStamped pending_goal_;
 };
 
 }  // namespace mbot_navigation

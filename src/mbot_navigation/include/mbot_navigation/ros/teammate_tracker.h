@@ -20,8 +20,8 @@ namespace mbot_navigation
 {
 /**
  * @brief The teammates' states from their topics, for the robots layers: which robots (a fixed
- *        list, or discovered from the /<name>/odom topics), their poses and velocities, and
- *        which of them reported recently enough to be trusted.
+ *        list, or discovered: the simulator's /stage/robots, else the /<name>/odom topics),
+ *        their poses and velocities, and which of them reported recently enough to be trusted.
  */
 class TeammateTracker
 {
@@ -33,17 +33,28 @@ public:
   };
 
   /**
+   * @param nh a handle of the node (its callback queue; the topics are absolute)
    * @param self this robot's name (never a teammate)
    * @param names a fixed list of teammates; empty: discover them (discover())
    * @param radius_of footprint radius [m] of a teammate, by name
    * @param timeout a teammate not heard of for this long [s] is left out
    */
-  TeammateTracker(tf2_ros::Buffer& tf, const std::string& self, const std::string& global_frame, Source source,
-                  const std::vector<std::string>& names, double timeout,
+  TeammateTracker(const ros::NodeHandle& nh, tf2_ros::Buffer& tf, const std::string& self,
+                  const std::string& global_frame, Source source, const std::vector<std::string>& names, double timeout,
                   std::function<double(const std::string&)> radius_of);
 
-  /// @brief Look for /<name>/odom topics (nav_msgs/Odometry) of robots not tracked yet.
-  void discover();
+  /**
+   * @brief Track robots not tracked yet: the simulator's list (parameter /stage/robots, cached:
+   *        the master pushes its changes, so this asks the master nothing), else, at most every
+   *        kTopicPollPeriod, the /<name>/odom topics (nav_msgs/Odometry) the master knows.
+   */
+  void discover(const ros::WallTime& now = ros::WallTime::now());
+  /// Without the simulator's list: the master's topic list at most this often [s wall].
+  static constexpr double kTopicPollPeriod = 10.0;
+  /// @brief Unsubscribe every teammate and forget their states (the costmaps are stopped).
+  void stop();
+  /// @brief Subscribe them again after stop().
+  void start();
   /// @brief The teammates that reported within `timeout` of `now`, in the global frame.
   std::vector<TeammateState> states(const ros::Time& now) const;
   /// @brief Names tracked so far.
@@ -57,7 +68,9 @@ private:
     double radius = 0.2;  ///< [m]
   };
   void track(const std::string& name);
+  void subscribe(const std::string& name, Mate& mate);
 
+  ros::NodeHandle nh_;
   tf2_ros::Buffer& tf_;
   std::string self_;
   std::string global_frame_;
@@ -65,6 +78,8 @@ private:
   double timeout_;
   std::function<double(const std::string&)> radius_of_;
   std::map<std::string, Mate> mates_;
+  bool stopped_ = false;
+  ros::WallTime next_topic_poll_;  ///< discover(): the master's topic list not before this
 };
 
 /**
