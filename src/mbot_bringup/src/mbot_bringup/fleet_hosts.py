@@ -450,6 +450,7 @@ def run(args):
     signal.signal(signal.SIGTERM, on_term)
     if netem and not kernel_netem:
         say(NO_NETEM)
+    os.makedirs(os.path.dirname(run_dir), exist_ok=True)   # the link's log goes beside the run dir until it exists
     hosts.up(netem, kernel_netem, link_log="%s-link.log" % run_dir.rstrip("/"))
     try:
         for k in range(2, args.hosts + 1):
