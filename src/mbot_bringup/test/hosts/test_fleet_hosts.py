@@ -31,7 +31,12 @@ def test_trio_on_three_hosts_passes_its_criteria(tmp_path):
     result = subprocess.run([SCRIPT, "run", "--hosts", "3", "triangle_trio", "--no-rviz", "--no-record",
                              "--run-dir", run_dir], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             universal_newlines=True, timeout=1800)
+    with open(str(tmp_path / "fleet-hosts.out"), "w") as f:
+        f.write(result.stdout)
     tail = "\n".join(result.stdout.splitlines()[-40:])
+    for name in ("hosts.json", "criteria.json"):
+        assert os.path.isfile(os.path.join(run_dir, name)), "no %s (exit status %d):\n%s" % (
+            name, result.returncode, tail)
     with open(os.path.join(run_dir, "hosts.json")) as f:
         hosts = json.load(f)
     assert [h["robots"] for h in hosts["hosts"]] == [["leader"], ["follower_1"], ["follower_2"]], tail
