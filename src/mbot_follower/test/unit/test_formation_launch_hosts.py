@@ -87,3 +87,18 @@ def test_formation_launch_part_robots_starts_only_the_stacks():
                                                   verbose=False)
     assert [n.name for n in config.nodes if not n.name.startswith("formation_fleet_")] == []
     assert len(config.nodes) == 1 and "--robots 'follower_1' --no-map-server" in " ".join(config.nodes[0].args.split())
+
+
+def test_across_hosts_the_coordinator_waits_longer_for_the_robots():
+    """The other hosts start their robots once the first host's master is up: later than its own."""
+    import subprocess
+
+    import yaml
+
+    def startup_timeout(*args):
+        out = subprocess.check_output(["roslaunch", "--dump-params", "mbot_follower", "formation.launch"] + list(args),
+                                      universal_newlines=True)
+        return yaml.safe_load(out).get("/coordinator/startup_timeout")
+
+    assert startup_timeout() is None                    # the coordinator's own default
+    assert startup_timeout("host_robots:=leader") == 150.0
