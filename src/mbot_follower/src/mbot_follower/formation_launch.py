@@ -121,8 +121,10 @@ def main(argv=None):
         maps = find_maps_directory(rospkg.RosPack().get_path("mbot_follower"))
         world = read_world(args.world, maps)
         robots = select_robots(world, args.robots)
+        # shutdown_costmaps: only the leader drives with its nav node; the others sleep (no laser,
+        # costmaps or tf) until the coordinator sends one of them a goal as the new leader.
         text = fleet_launch_xml(world, args.localization, config_dir=args.config_dir, output=args.output,
-                                robots=robots,
+                                robots=robots, shutdown_costmaps=True,
                                 extra_lines=controller_lines(world, args.controller, args.output,
                                                              args.controller_config, args.leader_max_vel,
                                                              args.lockstep, robots))
