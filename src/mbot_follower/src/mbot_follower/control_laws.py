@@ -87,8 +87,6 @@ class ControllerConfig(object):
         self.yield_stagger = 0.5           # ... plus this per follower slot farther back than its own [s]
         self.yield_time = 1.5              # how long to back away from what holds it [s]
         self.yield_speed = 0.15            # how fast [m/s]
-        self.energy_k_v = 4.0              # power per speed^2 [W/(m/s)^2]
-        self.energy_k_w = 0.5              # power per turn rate^2 [W/(rad/s)^2]
         self.omni = False                  # True: holonomic robot (uses vy)
         if values:
             self.update(values)
@@ -113,8 +111,6 @@ class ControllerConfig(object):
         "yield_stagger": (float, lambda v: v >= 0, ">= 0"),
         "yield_time": (float, lambda v: v >= 0, ">= 0"),
         "yield_speed": (float, lambda v: v >= 0, ">= 0"),
-        "energy_k_v": (float, lambda v: v >= 0, ">= 0"),
-        "energy_k_w": (float, lambda v: v >= 0, ">= 0"),
         "omni": (bool, None, None),
     }
 

@@ -182,6 +182,11 @@ class FleetCoordinator(object):
 
     # --- what the outside sees ----------------------------------------------------------------
 
+    @property
+    def switching(self):
+        """A formation switch is under way: from its request until the new shape stands."""
+        return self._switch_started is not None
+
     def state(self):
         if self.lost and self.phase not in (ARRIVED, ABORTED):
             return DEGRADED
@@ -259,7 +264,8 @@ class FleetCoordinator(object):
         :param last_heard: {robot: sim time [s] it was last complete (pose, and controller for a follower)}
         :param leader_nav: the leader's navigation: None (no goal), "ACTIVE", "SUCCEEDED" or
             "ABORTED: <why>"
-        :param obstacle_ahead: something is close in front of the leader
+        :param obstacle_ahead: something is close in front of the leader (True, or the reason as a
+            str: the leader's view is stale)
         :param excused: followers off their slot for a reason the leader's waiting would not cure
             (following the leader's trail past a wall, held by their safety layer); not after a
             switch (module docstring)
@@ -333,7 +339,8 @@ class FleetCoordinator(object):
             self.paused = True
             self._switch_fast = False
             self._pause_until = now + self.config.pause_time
-            self.reason = "paused: obstacle in front of the leader %s" % self.leader
+            self.reason = "paused: %s" % (obstacle_ahead if isinstance(obstacle_ahead, str) else
+                                          "obstacle in front of the leader %s" % self.leader)
             self.events.append((now, "pause", self.reason))
             return [("cancel", self.leader)]
         if leader_nav is not None and leader_nav.startswith("ABORTED"):

@@ -25,7 +25,8 @@ import rospy
 from mbot_common.geometry import Pose2D
 from mbot_follower.control_laws import safety_stop
 from mbot_follower.coordinator import ABORTED, ARRIVED, CoordinatorConfig, FleetCoordinator
-from mbot_follower.fleet_io import StalePose, assignment_to_msg, lookup_pose, quiet_at_shutdown
+from mbot_follower.fleet_io import (CachedParams, StalePose, assignment_to_msg, lookup_pose, quiet_at_shutdown,
+                                    stale_scan)
 from mbot_follower.formations import FormationLibrary
 from mbot_follower.free_space import FreeSpace
 from mbot_follower import markers
@@ -35,13 +36,18 @@ NODE_PARAMS = {
     "max_pose_age": 0.5,       # a robot's pose older than this does not count as seen [s]
     "pause_distance": 1.2,     # obstacle this close in front of the leader pauses the fleet [m]
     "pause_half_angle": math.radians(30.0),  # half-width of "in front" [rad]
+    "max_scan_age": 0.3,       # an older leader scan pauses the fleet: a stale view is not safe [s]
     "map_clearance": 0.2,      # a target closer than this to a wall is refused [m]
     "debug_mode": False,       # print every follower's slot error once per second
     "startup_timeout": 60.0,   # [s wall] wait this long for every robot before counting absent ones lost
     "view_frame": "fleet",     # tf frame at the middle of the fleet ("" = none)
     "lockstep": False,         # the simulator's lockstep holds sim time for this node's heartbeat
     "loss_wall_wait": 1.0,     # [s wall] under lockstep: how long an overdue robot is waited for
+    "param_refresh": 1.0,      # how often the private parameters are read again [s sim time]
 }
+# read once at the start: a change (rosparam set) is a warning that it needs a restart. The
+# rest (NODE_PARAMS and CoordinatorConfig) apply at the next ~param_refresh.
+RESTART_PARAMS = ("rate", "map_clearance", "robots", "world", "leader", "formation", "spacing", "formation_file")
 
 
 def _robots_from_params():
@@ -72,13 +78,14 @@ class CoordinatorNode(object):
         from visualization_msgs.msg import MarkerArray
 
         self._FleetStatus = FleetStatus
-        self.params = {k: type(v)(rospy.get_param("~" + k, v)) for k, v in NODE_PARAMS.items()}
+        self.params = dict(NODE_PARAMS)
         self.robots = _robots_from_params()
         leader = rospy.get_param("~leader", "") or self.robots[0]
         config = CoordinatorConfig()
-        for key in vars(config):
-            if rospy.has_param("~" + key):
-                setattr(config, key, type(getattr(config, key))(rospy.get_param("~" + key)))
+        # rospy's parameter cache (as the follower): a rosparam set reaches the node without polling
+        self._param_cache = CachedParams(dict(NODE_PARAMS, **vars(config)))
+        self._init_params(config)
+        self._read_params(self._param_cache.values(), config, startup=True)
         library = FormationLibrary()
         formation_file = rospy.get_param("~formation_file", "")
         if formation_file:
@@ -93,6 +100,7 @@ class CoordinatorNode(object):
         self.leader_scan = None
         self._scan_sub = None
         self._scan_robot = None
+        self._scan_since = None      # [s sim] when the leader's scan was subscribed
         self._nav_robot = None       # whose move_base has our goal
         self._published_state = None
         self._last_status = None
@@ -100,7 +108,8 @@ class CoordinatorNode(object):
         self._startup_done = False
         self._waited_for = set()     # overdue robots given their wall-time wait (lockstep)
         self._last_nav = None
-        self._wall_start = time.time()
+        self._wall_clock, self._sleep = time.monotonic, time.sleep   # unit tests inject their own
+        self._wall_start = self._wall_clock()
 
         self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0))
         self._tf_listener = tf2_ros.TransformListener(self.tf_buffer)
@@ -134,6 +143,68 @@ class CoordinatorNode(object):
         self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
         rospy.loginfo("coordinator: robots %s, leader %s, formation %s (spacing %.2f m)", ", ".join(self.robots),
                       leader, self.core.formation, self.core.spacing)
+
+    # --- parameters ---------------------------------------------------------------------------
+
+    def _init_params(self, config):
+        """The parameter state before the first read (no ROS calls: unit tests build the node so)."""
+        self._config_keys = set(vars(config))
+        self._started_with = {}       # restart-only key -> its value at the start
+        self._warned_keys = set()
+        self._last_param_read = None
+
+    def _read_params(self, values, config, startup=False):
+        """Apply the private parameters `values` to self.params and `config` (the core's).
+        At the start a bad value is an error (ValueError naming it); later it is refused with an
+        error and the previous value stays. A changed restart-only key is a warning, once."""
+        for key, value in sorted(values.items()):
+            if key in RESTART_PARAMS and key not in NODE_PARAMS:
+                if startup:
+                    self._started_with[key] = value
+                elif value != self._started_with.get(key, value):
+                    self._warn_restart(key, value, self._started_with[key])
+                continue
+            if key in NODE_PARAMS:
+                current = self.params[key]
+            elif key in self._config_keys:
+                current = getattr(config, key)
+            else:
+                if key not in self._warned_keys:
+                    self._warned_keys.add(key)
+                    rospy.logwarn("coordinator: unknown parameter ~%s (ignored)", key)
+                continue
+            try:
+                # bool("false") is True: a bool wants a bool; a float takes an int
+                if isinstance(current, bool) and not isinstance(value, bool):
+                    raise ValueError
+                value = type(current)(value)
+            except (TypeError, ValueError):
+                message = "parameter ~%s: expected a %s, got %r" % (key, type(current).__name__, value)
+                if startup:
+                    raise ValueError(message)
+                rospy.logerr_throttle(5.0, "coordinator: %s: refused, keeping %r" % (message, current))
+                continue
+            if value == current:
+                continue
+            if key in RESTART_PARAMS and not startup:
+                self._warn_restart(key, value, current)
+            elif key in NODE_PARAMS:
+                self.params[key] = value
+            else:
+                setattr(config, key, value)
+            if not startup and key not in RESTART_PARAMS:
+                rospy.loginfo("coordinator: ~%s = %r (was %r)", key, value, current)
+
+    def _warn_restart(self, key, value, running):
+        if (key, value) not in self._warned_keys:
+            self._warned_keys.add((key, value))
+            rospy.logwarn("coordinator: ~%s changed to %r: it takes effect when the node restarts (running "
+                          "with %r)", key, value, running)
+
+    def _refresh_params(self, now):
+        if self._last_param_read is None or now - self._last_param_read >= self.params["param_refresh"]:
+            self._last_param_read = now
+            self._read_params(self._param_cache.values(), self.core.config)
 
     # --- commands -----------------------------------------------------------------------------
 
@@ -225,7 +296,7 @@ class CoordinatorNode(object):
     def _on_scan(self, msg):
         self.leader_scan = msg
 
-    def _follow_leader_scan(self, leader):
+    def _follow_leader_scan(self, leader, now):
         from sensor_msgs.msg import LaserScan
 
         if self._scan_robot == leader:
@@ -234,7 +305,24 @@ class CoordinatorNode(object):
             self._scan_sub.unregister()
         self.leader_scan = None
         self._scan_robot = leader
+        self._scan_since = now
         self._scan_sub = rospy.Subscriber("/%s/scan" % leader, LaserScan, self._on_scan, queue_size=1)
+
+    def _obstacle_ahead(self, leader, now):
+        """Why the fleet must pause for what is in front of the leader (a str), or False. The
+        leader's scan older than ~max_scan_age is a reason: a stale view is not a safe one (the
+        follower's safety layer has the same rule, fleet_io.stale_scan)."""
+        scan = self.leader_scan
+        why = stale_scan(scan.header.stamp.to_sec() if scan is not None else None, now,
+                         self.params["max_scan_age"], self._scan_since)
+        if why is not None:
+            rospy.logwarn_throttle(2.0, "coordinator: the leader %s's scan (/%s/scan): %s: the fleet pauses" % (
+                leader, leader, why))
+            return "the leader %s's scan: %s" % (leader, why)
+        if scan is not None and safety_stop(scan.ranges, scan.angle_min, scan.angle_increment,
+                                            self.params["pause_distance"], self.params["pause_half_angle"]):
+            return "obstacle in front of the leader %s" % leader
+        return False
 
     # --- the cycle ----------------------------------------------------------------------------
 
@@ -297,13 +385,13 @@ class CoordinatorNode(object):
         self._waited_for &= overdue   # heard again: its next silence is waited for again
         if not overdue - self._waited_for:
             return poses
-        started = time.time()
-        while time.time() - started < self.params["loss_wall_wait"] and not rospy.is_shutdown():
-            time.sleep(0.01)
+        started = self._wall_clock()
+        while self._wall_clock() - started < self.params["loss_wall_wait"] and not rospy.is_shutdown():
+            self._sleep(0.01)
             poses = self._look_up_poses(now_ros)
             if not overdue & self._overdue(now, leader):
                 rospy.logwarn("coordinator: the messages of %s came %.2f s of wall time late (a loaded machine)",
-                              ", ".join(sorted(overdue)), time.time() - started)
+                              ", ".join(sorted(overdue)), self._wall_clock() - started)
                 return poses
         self._waited_for |= self._overdue(now, leader)
         return poses
@@ -311,6 +399,8 @@ class CoordinatorNode(object):
     def _step(self, _event):
         now_ros = rospy.Time.now()
         now = now_ros.to_sec()
+        with self.lock:
+            self._refresh_params(now)
         leader = self.core.leader
         poses = self._wait_for_overdue(now_ros, leader, self._look_up_poses(now_ros))
         with self.lock:
@@ -319,10 +409,8 @@ class CoordinatorNode(object):
             last_heard, pose_lag, controller_lag = self._last_heard(now, leader)
             if not self._started(last_heard, now):
                 return
-            self._follow_leader_scan(leader)
-            scan = self.leader_scan
-            obstacle = scan is not None and safety_stop(scan.ranges, scan.angle_min, scan.angle_increment,
-                                                        self.params["pause_distance"], self.params["pause_half_angle"])
+            self._follow_leader_scan(leader, now)
+            obstacle = self._obstacle_ahead(leader, now)
             # followers off their slot for a reason the leader's waiting would not cure
             excused = [r for r, mode in self.controller_mode.items() if mode in ("trail", "safety_stop")]
             nav = self._leader_nav()
@@ -372,7 +460,7 @@ class CoordinatorNode(object):
         if self._startup_done:
             return True
         missing = [r for r in self.robots if now - last_heard[r] > self.core.config.loss_timeout]
-        if missing and time.time() - self._wall_start < self.params["startup_timeout"]:
+        if missing and self._wall_clock() - self._wall_start < self.params["startup_timeout"]:
             rospy.loginfo_throttle(5.0, "coordinator: waiting for %s" % ", ".join(missing))
             return False
         if missing:
@@ -438,7 +526,7 @@ class CoordinatorNode(object):
 
     def _publish_status(self, force=False, stamp=None):
         c = self.core
-        key = (c.state(), c.reason, c.leader, c.formation, tuple(c.members), tuple(c.lost), c.paused)
+        key = (c.state(), c.reason, c.leader, c.formation, tuple(c.members), tuple(c.lost), c.paused, c.switching)
         now = stamp or rospy.Time.now()
         if not force and key == self._published_state and self._last_status is not None \
                 and (now - self._last_status).to_sec() < 0.5:
@@ -451,7 +539,7 @@ class CoordinatorNode(object):
         msg.header.stamp = now
         msg.header.frame_id = "map"
         msg.state, msg.reason, msg.formation, msg.spacing = c.state(), c.reason, c.formation, c.spacing
-        msg.leader, msg.lost, msg.paused = c.leader, list(c.lost), c.paused
+        msg.leader, msg.lost, msg.paused, msg.switching = c.leader, list(c.lost), c.paused, c.switching
         msg.members = sorted(c.members, key=lambda r: r != c.leader)   # the leader first, as the message says
         if c.target is not None:
             msg.has_target = True

@@ -40,6 +40,21 @@ def quiet_at_shutdown(callback):
     return wrapped
 
 
+def stale_scan(stamp, now, max_age, since=None):
+    """Why a laser view is too old to trust, or None when it is current: the rule of the
+    follower's safety layer and of the coordinator's leader pause (an old view of free space is
+    none). `stamp` [s] is the newest scan's header stamp (None: no scan yet); `since` [s] is when
+    the node began to listen: no scan yet is stale only once max_age has passed since then."""
+    if stamp is None:
+        if since is not None and now - since <= max_age:
+            return None
+        return "no scan yet"
+    age = now - stamp
+    if age > max_age:
+        return "newest scan is %.2f s old (limit ~max_scan_age %.2f s)" % (age, max_age)
+    return None
+
+
 class CachedParams(object):
     """A node's private parameters (``~``) from rospy's parameter cache.
 
@@ -172,7 +187,7 @@ def assignment_to_msg(assignment, stamp):
     return msg
 
 
-def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0):
+def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0, clock=None, sleep=None):
     """Pose of `source_frame` in `target_frame` from the newest transform in a tf2 Buffer.
 
     :param now: rospy.Time (sim time) the age is measured against
@@ -180,6 +195,7 @@ def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0)
     :param wall_wait: [s wall] how long to poll for a current transform when the newest is too
         old. A loaded machine delivers /tf later than /clock; under lockstep sim time waits for
         this node, so the transform is on its way. The wait is in wall time, never in sim time.
+    :param clock, sleep: the wall clock and its sleep (time.monotonic, time.sleep; tests inject theirs)
     :returns: (Pose2D, stamp)
     :raises StalePose: no transform, or the newest one is older than max_age
     """
@@ -188,7 +204,9 @@ def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0)
     import rospy
     import tf2_ros
 
-    deadline = time.time() + wall_wait
+    clock = clock or time.monotonic
+    sleep = sleep or time.sleep
+    deadline = clock() + wall_wait
     while True:
         try:
             t = buffer.lookup_transform(target_frame, source_frame, rospy.Time(0))
@@ -199,6 +217,6 @@ def lookup_pose(buffer, target_frame, source_frame, now, max_age, wall_wait=0.0)
         if problem is None:
             tr = t.transform.translation
             return Pose2D(tr.x, tr.y, yaw_of(t.transform.rotation)), t.header.stamp
-        if time.time() >= deadline:
+        if clock() >= deadline:
             raise StalePose("%s -> %s: %s" % (target_frame, source_frame, problem))
-        time.sleep(0.002)
+        sleep(0.002)

@@ -34,7 +34,8 @@ Every control period (sim time) it
    than ``safety_distance`` within +-``safety_half_angle`` of the direction of travel, or in
    the lane the body sweeps next (``safety_near_distance`` long, +-``safety_lane_half_width``
    wide), stops the robot's travel;
-5. publishes ``cmd_vel``, ``power`` (the energy model's rate) and ``~state`` (FollowerState).
+5. publishes ``cmd_vel`` and ``~state`` (FollowerState). (Every robot's power and energy are the
+   metrics collector's, from its measured velocity, whoever commands it.)
 
 While its robot leads (the assignment names it), the node publishes no command: the robot's
 move_base drives it. Before the first assignment, and while the fleet is IDLE, ABORTED or paused,
@@ -55,9 +56,9 @@ import rospy
 
 from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, detour,
-                                        energy_rate, make_control_law, safety_filter, scan_points, way_blocked)
+                                        make_control_law, safety_filter, scan_points, way_blocked)
 from mbot_follower.fleet_io import (CachedParams, RobotTfListener, StalePose, assignment_from_msg, lookup_pose,
-                                    quiet_at_shutdown)
+                                    quiet_at_shutdown, stale_scan)
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.merge import merge_target, robot_ahead
 from mbot_follower.trail import Trail, path_pose, path_slot
@@ -95,9 +96,8 @@ class FollowerController(object):
         from mbot_msgs.msg import FleetAssignment, FleetStatus, FollowerState
         from nav_msgs.msg import OccupancyGrid, Odometry
         from sensor_msgs.msg import LaserScan
-        from std_msgs.msg import Float64
 
-        self._msg = {"Twist": Twist, "FollowerState": FollowerState, "Float64": Float64, "Odometry": Odometry}
+        self._msg = {"Twist": Twist, "FollowerState": FollowerState, "Odometry": Odometry}
         self.robot = rospy.get_namespace().strip("/")
         if not self.robot:
             raise ValueError("follower_controller must run in a robot's namespace (ns=\"follower_1\")")
@@ -110,7 +110,6 @@ class FollowerController(object):
         self._tf = RobotTfListener(self.tf_buffer, self.params["tf_source"])
         self._tf.follow({self.robot})
         self.cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=1)
-        self.power_pub = rospy.Publisher("power", Float64, queue_size=1)
         self.state_pub = rospy.Publisher("~state", FollowerState, queue_size=10)
         rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=1)
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
@@ -151,6 +150,8 @@ class FollowerController(object):
         self.lookups = 0
         self.lookup_failures = 0
         self.cycle_failures = 0
+        self.overruns = 0        # cycles whose computation took longer than the period [wall]
+        self.late_starts = 0     # cycles that began a period or more after their time [sim]
 
     # --- parameters ---------------------------------------------------------------------------
 
@@ -258,10 +259,14 @@ class FollowerController(object):
 
     # --- the control cycle --------------------------------------------------------------------
 
-    def _cycle(self, _event):
+    def _cycle(self, event):
         """One control period: the step under the node's lock; a failure is logged, holds the
         robot still and the next period runs as usual."""
         with self.lock:
+            period = 1.0 / self.params["rate"]
+            if event is not None and event.current_expected is not None and event.current_real is not None \
+                    and (event.current_real - event.current_expected).to_sec() >= period:
+                self.late_starts += 1   # this cycle began a period or more after its time (sim)
             try:
                 self._step(rospy.Time.now())
             except rospy.ROSException:
@@ -339,11 +344,10 @@ class FollowerController(object):
         twist = frame_twist if mode in ("slot", "merge", "detour") else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
-        scan_age = (now - self.scan.header.stamp).to_sec() if self.scan is not None else math.inf
-        if scan_age > self.params["max_scan_age"]:
+        why = stale_scan(self.scan.header.stamp.to_sec() if self.scan is not None else None, now.to_sec(),
+                         self.params["max_scan_age"])
+        if why is not None:
             # The safety layer sees only through the laser: an old view of free space is none.
-            why = ("no scan yet" if self.scan is None else "newest scan is %.2f s old (limit ~max_scan_age %.2f s)"
-                   % (scan_age, self.params["max_scan_age"]))
             rospy.logwarn_throttle(2.0, "%s: %s on %s: holding still" % (
                 rospy.get_name(), why, rospy.resolve_name("scan")))
             self._hold()
@@ -558,7 +562,6 @@ class FollowerController(object):
         msg = self._msg["Twist"]()
         msg.linear.x, msg.linear.y, msg.angular.z = cmd.vx, cmd.vy, cmd.wz
         self.cmd_pub.publish(msg)
-        self.power_pub.publish(self._msg["Float64"](energy_rate(cmd, self.config.energy_k_v, self.config.energy_k_w)))
 
     def _publish_state(self, now, mode, started, pose_stamp=None, err=(0.0, 0.0), heading_error=0.0, cmd=None):
         msg = self._msg["FollowerState"]()
@@ -575,6 +578,9 @@ class FollowerController(object):
         msg.lookups = self.lookups
         msg.lookup_failures = self.lookup_failures
         msg.cycle_time = time.time() - started
+        if msg.cycle_time > 1.0 / self.params["rate"]:
+            self.overruns += 1   # took longer than its period (wall): the next one starts late
+        msg.overruns, msg.late_starts = self.overruns, self.late_starts
         self.state_pub.publish(msg)
 
 

@@ -17,7 +17,8 @@ One run (one fleet size, one seed) in ``field``, an empty 40 x 40 m room:
    DEGRADED with the slots re-planned, and **recover_s**, until the others' slot error RMS stays
    below 0.15 m for 1 s (both timed from the controller's last message: a loss is 1 s of silence);
 6. **contacts** (from the simulator) and **cycle_p99_ms** (the controllers' cycle time, wall)
-   from the metrics collector.
+   with beside it **overruns** (cycles that took longer than the 50 ms period, all followers) and
+   **late_starts** (cycles that began a period or more late), from the metrics collector.
 
 The times (converge, switch, DEGRADED, recover) and both slot RMS are read after the run from
 the metrics collector's record (``timings``): it stamps every sample and event with the sim time
@@ -93,7 +94,9 @@ def world_yaml(poses, map_path):
 def worst(runs):
     """One table row from the runs of a fleet size: worst value per measure, success counted."""
     row = {"runs": len(runs), "succeeded": sum(1 for r in runs if r.get("succeeded")),
-           "contacts": sum(r.get("contacts", 0) for r in runs)}
+           "contacts": sum(r.get("contacts", 0) for r in runs),
+           "overruns": sum(r.get("overruns") or 0 for r in runs),
+           "late_starts": sum(r.get("late_starts") or 0 for r in runs)}
     for key in ("rms_straight_m", "rms_route_m", "converge_s", "switch_s", "degraded_s", "recover_s",
                 "cycle_p99_ms"):
         values = [r[key] for r in runs if r.get(key) is not None]
@@ -319,6 +322,8 @@ def run_one(n, seed, out_dir, log):
         with open(metrics) as f:
             fleet = json.load(f)["fleet"]
         result["cycle_p99_ms"] = fleet.get("cycle_time_p99_ms")
+        result["overruns"] = fleet.get("cycle_overruns")
+        result["late_starts"] = fleet.get("cycle_late_starts")
         result["contacts"] = max(result.get("contacts", 0), fleet.get("contacts") or 0)
         try:
             result.update(timings(load_run(os.path.dirname(metrics)), result.get("route")))

@@ -5,8 +5,8 @@ assignment, the coordinator's status, the follower controllers' states, power, c
 leader's plan) and keeps a `Run`:
   * one `Sample` at every multiple of 1/rate sim seconds, with the newest ground-truth pose of
     every robot at or before that time (taken when the first later pose arrives),
-  * the `Event`s: state changes, assignments, switches (the formation changed), losses, rejoins,
-    contacts,
+  * the `Event`s: state changes, assignments, switches (the formation changed; switch_done when
+    the coordinator saw the new shape stand), pauses (start, end), losses, rejoins, contacts,
   * one `ControllerSample` per follower controller cycle.
 `summarize(run)` turns a Run into the numbers of metrics.json. `RunWriter` writes a Run to
 metrics.csv, events.csv, controller.csv and metrics.json; `load_run(output_dir)` reads them back
@@ -44,7 +44,10 @@ What the numbers mean (all times sim time unless marked wall):
   distance          path length of each robot's ground truth (jumps faster than teleport_speed
                     and gaps longer than stale_after are not travel).
   energy            integral of each robot's power over sim time: every power value holds until
-                    the next one, for at most stale_after. [J] if power is in [W].
+                    the next one, for at most stale_after. [J] if power is in [W]. The power is
+                    the power model (control_laws.energy_rate, energy_k_v, energy_k_w) of the
+                    velocity each ground-truth pose carries: what the robot really does, whoever
+                    commands it (its follower controller, its move_base, nothing).
   sampling          a sample at t uses every robot's newest pose not later than t (and not older
                     than stale_after). Each robot's poses come on their own topic, and a busy
                     machine delivers one stream later than another (at real_time_factor 0 a
@@ -69,6 +72,8 @@ from collections import namedtuple
 
 import numpy as np
 
+from mbot_common.geometry import Twist2D
+from mbot_follower.control_laws import energy_rate
 from mbot_follower.shape import ShapeErrors, rigid_fit, shape_errors
 from mbot_follower.trail import Trail, slot_pose
 
@@ -90,12 +95,16 @@ Sample = namedtuple("Sample", "t state leader formation lost slot_rms slot_max f
 #: Something that happened at t [s]. kind / name / detail:
 #:   state / new state / reason        assignment / formation / "leader L spacing S m [along_path] slots ..."
 #:   switch / new formation / old one  loss, rejoin / robot / ""
+#:   switch_done / formation / reason  pause / "start" or "end" / the coordinator's reason
 #:   contact / body_a / body_b, at x, y [m] (NaN for the other kinds)
 Event = namedtuple("Event", "t kind name detail x y")
 
 #: One follower controller cycle: t [s] when the command was computed, latency [s] (NaN if the
-#: cycle used no pose), cycle_time_ms [ms wall], the controller's lookup counters, its mode.
-ControllerSample = namedtuple("ControllerSample", "t robot latency cycle_time_ms lookups lookup_failures mode")
+#: cycle used no pose), cycle_time_ms [ms wall], the controller's lookup counters, its mode, and
+#: its overrun counters so far: cycles that took longer than the period, cycles that started a
+#: period or more late.
+ControllerSample = namedtuple("ControllerSample", "t robot latency cycle_time_ms lookups lookup_failures mode "
+                              "overruns late_starts", defaults=(0, 0))
 
 
 class MetricsConfig(object):
@@ -103,7 +112,7 @@ class MetricsConfig(object):
 
     def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
                  robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0,
-                 slot_clearance=0.25, free_hold=3.0, controller_silence=0.5):
+                 slot_clearance=0.25, free_hold=3.0, controller_silence=0.5, energy_k_v=4.0, energy_k_w=0.5):
         self.rate = rate                      # samples per sim second [Hz]
         self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
@@ -116,6 +125,9 @@ class MetricsConfig(object):
         self.slot_clearance = slot_clearance  # a slot closer than this to a wall is not free [m]
         self.free_hold = free_hold            # a slot free this long counts in the steady RMS [s]
         self.controller_silence = controller_silence  # a controller unheard this long is gone [s]
+        # the power model (control_laws.energy_rate) of every robot's measured velocity [W/(m/s)^2, W/(rad/s)^2]
+        self.energy_k_v = energy_k_v
+        self.energy_k_w = energy_k_w
         self.check()
 
     def check(self):
@@ -123,7 +135,8 @@ class MetricsConfig(object):
         limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
                   ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True),
-                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True), ("controller_silence", 0.0, False)]
+                  ("slot_clearance", 0.0, True), ("free_hold", 0.0, True), ("controller_silence", 0.0, False),
+                  ("energy_k_v", 0.0, True), ("energy_k_w", 0.0, True)]
         for key, low, low_ok in limits:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
@@ -187,6 +200,8 @@ class MetricsCollector(object):
         self.assignment = None   # fleet_io.Assignment (or anything with .leader .formation .spacing .slots)
         self.state = ""          # coordinator state, "" before the first status
         self.lost = ()           # robots the status reports lost
+        self.paused = False      # the status says the fleet is paused
+        self.switching = False   # the status says a formation switch is under way
         self.poses = {}          # robot -> (t, x, y, theta): the newest ground truth
         self.history = {}        # robot -> [(t, x, y, theta, distance)] of the last hold_back + stale_after seconds
         self.distance = {}       # robot -> path length so far [m]
@@ -212,13 +227,16 @@ class MetricsCollector(object):
 
     # --- inputs -------------------------------------------------------------------------
 
-    def on_pose(self, robot, t, x, y, theta):
-        """A ground-truth pose in map; then every sample whose time all robots' streams have
-        passed (module docstring: sampling)."""
+    def on_pose(self, robot, t, x, y, theta, twist=None):
+        """A ground-truth pose in map, with its body-frame velocity `twist` (vx, vy, wz) when
+        known (its power, module docstring: energy); then every sample whose time all robots'
+        streams have passed (module docstring: sampling)."""
         self._know(robot)
         previous = self.poses.get(robot)
         if previous is not None and t < previous[0]:
             return   # older than what we have: arrived out of order
+        if twist is not None:
+            self.on_power(robot, t, energy_rate(Twist2D(*twist), self.config.energy_k_v, self.config.energy_k_w))
         if previous is not None and 0.0 < t - previous[0] <= self.config.stale_after:
             step = math.hypot(x - previous[1], y - previous[2])
             if step <= self.config.teleport_speed * (t - previous[0]):
@@ -271,8 +289,17 @@ class MetricsCollector(object):
         if old is not None and old.formation != assignment.formation:
             self.run.events.append(Event(t, "switch", assignment.formation, old.formation, NAN, NAN))
 
-    def on_status(self, t, state, reason, lost):
-        """The coordinator's status: records state changes, new losses and rejoins."""
+    def on_status(self, t, state, reason, lost, paused=False, switching=False):
+        """The coordinator's status: records state changes, new losses and rejoins, the start and
+        end of a pause (paused) and the end of a switch (switching goes off: the coordinator saw
+        the new shape stand). A pause keeps the state NAVIGATING: its events are what records it."""
+        if paused != self.paused:
+            self.run.events.append(Event(t, "pause", "start" if paused else "end", reason, NAN, NAN))
+            self.paused = paused
+        if self.switching and not switching:
+            self.run.events.append(Event(t, "switch_done", self.assignment.formation if self.assignment else "",
+                                         reason, NAN, NAN))
+        self.switching = switching
         if state != self.state:
             self.run.events.append(Event(t, "state", state, reason, NAN, NAN))
             self.state = state
@@ -291,13 +318,16 @@ class MetricsCollector(object):
                 self.run.events.append(Event(t, "rejoin", robot, "", NAN, NAN))
         self.lost = lost
 
-    def on_follower_state(self, robot, t, pose_stamp, active, lookups, lookup_failures, cycle_time, mode):
-        """One follower controller cycle: t and pose_stamp [s sim], cycle_time [s wall]. Its latency
-        is t - pose_stamp + physics_step (the simulator applies the command at its next step)."""
+    def on_follower_state(self, robot, t, pose_stamp, active, lookups, lookup_failures, cycle_time, mode,
+                          overruns=0, late_starts=0):
+        """One follower controller cycle: t and pose_stamp [s sim], cycle_time [s wall], the
+        overrun counters so far. Its latency is t - pose_stamp + physics_step (the simulator
+        applies the command at its next step)."""
         self._know(robot)
         latency = t - pose_stamp + self.config.physics_step if active and pose_stamp > 0.0 else NAN
         self.run.controller.append(ControllerSample(t, robot, latency, 1000.0 * cycle_time,
-                                                    int(lookups), int(lookup_failures), mode))
+                                                    int(lookups), int(lookup_failures), mode,
+                                                    int(overruns), int(late_starts)))
 
     def on_power(self, robot, t, power):
         """The energy model's rate [W] of a robot; it holds until the next one (at most stale_after)."""
@@ -433,7 +463,8 @@ def _stats(values, prefix, unit, rms=False, percentiles=()):
 
 
 def _controller_stats(rows):
-    """Latency p50/p95/max, tf success rate (newest counters per robot), cycle time p99."""
+    """Latency p50/p95/max, tf success rate (newest counters per robot), cycle time p99 and the
+    overruns and late starts (newest counters per robot, summed)."""
     newest = {}
     for row in rows:
         newest[row.robot] = row
@@ -443,6 +474,9 @@ def _controller_stats(rows):
     out["tf_success_rate"] = 1.0 - failures / float(lookups) if lookups > 0 else None
     out["cycle_time_p99_ms"] = _stats([r.cycle_time_ms for r in rows], "cycle_time", "ms",
                                       percentiles=(99,))["cycle_time_p99_ms"]
+    # beside the cycle time: how often a controller missed its period (newest counters per robot)
+    out["cycle_overruns"] = sum(r.overruns for r in newest.values())
+    out["cycle_late_starts"] = sum(r.late_starts for r in newest.values())
     return out
 
 
@@ -619,7 +653,8 @@ ROBOT_COLUMNS = ["x_m", "y_m", "theta_rad", "slot_error_m", "fit_error_m", "dist
 #: what runs recorded before slot_free have
 OLD_ROBOT_COLUMNS = ROBOT_COLUMNS[:-1]
 EVENT_COLUMNS = ["t_s", "kind", "name", "detail", "x_m", "y_m"]
-CONTROLLER_COLUMNS = ["t_s", "robot", "latency_s", "cycle_time_ms", "lookups", "lookup_failures", "mode"]
+CONTROLLER_COLUMNS = ["t_s", "robot", "latency_s", "cycle_time_ms", "lookups", "lookup_failures", "mode",
+                      "overruns", "late_starts"]
 FILES = ("metrics.csv", "events.csv", "controller.csv", "metrics.json")
 
 
@@ -774,11 +809,16 @@ def load_run(output_dir):
                                 _float(path, number, "x_m", row[4]), _float(path, number, "y_m", row[5])))
 
     path = os.path.join(output_dir, "controller.csv")
-    for number, row in enumerate(_read_csv(path, CONTROLLER_COLUMNS)[1], start=2):
+    header, rows = _read_csv(path)
+    if header not in (CONTROLLER_COLUMNS, CONTROLLER_COLUMNS[:7]):   # a run of before the overrun counters
+        _read_csv(path, CONTROLLER_COLUMNS)   # raises, naming the expected columns
+    for number, row in enumerate(rows, start=2):
+        counters = [_int(path, number, "overruns", row[7]), _int(path, number, "late_starts", row[8])] \
+            if len(row) > 7 else [0, 0]
         run.controller.append(ControllerSample(
             _float(path, number, "t_s", row[0]), row[1], _float(path, number, "latency_s", row[2]),
             _float(path, number, "cycle_time_ms", row[3]), _int(path, number, "lookups", row[4]),
-            _int(path, number, "lookup_failures", row[5]), row[6]))
+            _int(path, number, "lookup_failures", row[5]), row[6], *counters))
     return run
 
 

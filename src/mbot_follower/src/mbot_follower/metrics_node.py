@@ -3,7 +3,7 @@
 Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts``, ``/map`` (is a slot
 in a wall?) and per robot
 ``/<ns>/base_pose_ground_truth`` (frame map), ``/<ns>/follower_controller/state``,
-``/<ns>/power`` and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
+and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
 robot that appears in an assignment (subscribed when it first appears).
 
 Outputs: ``/fleet/metrics`` (mbot_msgs/FleetMetrics, every ``~publish_period``, 1 s) and, when
@@ -26,7 +26,7 @@ import time
 import rospy
 from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
 from nav_msgs.msg import OccupancyGrid, Odometry, Path
-from std_msgs.msg import Float64, Header
+from std_msgs.msg import Header
 
 from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
@@ -110,7 +110,6 @@ class MetricsNode(object):
             rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth, robot, queue_size=200),
             rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self.on_state, robot,
                              queue_size=100),
-            rospy.Subscriber("/%s/power" % robot, Float64, self.on_power, robot, queue_size=100),
             rospy.Subscriber("/%s/move_base/global_plan" % robot, Path, self.on_plan, robot, queue_size=5),
         ]
 
@@ -134,7 +133,8 @@ class MetricsNode(object):
     def on_status(self, msg):
         with self.lock:
             if not self.closed:
-                self.collector.on_status(stamp_of(msg.header), msg.state, msg.reason, msg.lost)
+                self.collector.on_status(stamp_of(msg.header), msg.state, msg.reason, msg.lost, msg.paused,
+                                         msg.switching)
 
     def on_contact(self, msg):
         with self.lock:
@@ -158,7 +158,9 @@ class MetricsNode(object):
             if self.closed:
                 return
             samples = len(self.collector.run.samples)
-            self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta)
+            v = msg.twist.twist
+            self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta,
+                                   (v.linear.x, v.linear.y, v.angular.z))
             if len(self.collector.run.samples) == samples:
                 return
             self.heartbeat.stamp = rospy.Time.from_sec(self.collector.run.samples[-1].t)
@@ -168,12 +170,8 @@ class MetricsNode(object):
         with self.lock:
             if not self.closed:
                 self.collector.on_follower_state(robot, stamp_of(msg.header), msg.pose_stamp.to_sec(), msg.active,
-                                                 msg.lookups, msg.lookup_failures, msg.cycle_time, msg.mode)
-
-    def on_power(self, msg, robot):
-        with self.lock:
-            if not self.closed:
-                self.collector.on_power(robot, rospy.get_time(), msg.data)
+                                                 msg.lookups, msg.lookup_failures, msg.cycle_time, msg.mode,
+                                                 msg.overruns, msg.late_starts)
 
     def on_plan(self, msg, robot):
         if msg.poses and msg.header.frame_id.lstrip("/") != "map":
@@ -221,6 +219,11 @@ class MetricsNode(object):
         msg.contacts = fleet["contacts"]
         msg.min_clearance = number("min_clearance_m")
         msg.energy = fleet["energy_j"]
+        with self.lock:
+            power = {r: p for r, (_, p) in self.collector.power.items()}
+        msg.robots = sorted(summary["robots"])
+        msg.robot_energy = [summary["robots"][r]["energy_j"] for r in msg.robots]
+        msg.robot_power = [power.get(r, 0.0) for r in msg.robots]
         msg.distance = fleet["distance_m"]
         self.pub.publish(msg)
 

@@ -54,7 +54,7 @@ def test_config_defaults_and_live_update():
 
 
 @pytest.mark.parametrize("values,says", [
-    ({"max_speed": 1.0}, "ControllerConfig: unknown key 'max_speed' (known: energy_k_v,"),
+    ({"max_speed": 1.0}, "ControllerConfig: unknown key 'max_speed' (known: "),
     ({"max_linear_vel": -0.5}, "ControllerConfig: max_linear_vel: expected a finite number > 0, got -0.5"),
     ({"max_angular_accel": 0}, "max_angular_accel: expected a finite number > 0, got 0.0"),
     ({"smoothing": 0.0}, "smoothing: expected a finite number in (0, 1], got 0.0"),
@@ -69,7 +69,7 @@ def test_config_rejects_bad_values_and_changes_nothing(values, says):
     c = ControllerConfig()
     before = c.to_dict()
     with pytest.raises(ValueError) as e:
-        c.update(dict(values, energy_k_v=9.0))     # a good key in the same call is not applied
+        c.update(dict(values, yield_speed=0.2))     # a good key in the same call is not applied
     assert says in str(e.value)
     assert c.to_dict() == before
 

@@ -68,20 +68,49 @@ def test_lookup_pose_refuses_an_old_transform_and_an_unknown_frame():
         fleet_io.lookup_pose(buffer, "map", "q/base_link", rospy.Time.from_sec(10.0), 0.1)
 
 
-def test_lookup_pose_polls_in_wall_time_for_a_transform_on_its_way():
-    import threading
-    import time
+class FakeWallClock(object):
+    """A wall clock that moves only when the code under test sleeps; `at` runs a callback once
+    the clock has passed a time (a message on its way)."""
 
+    def __init__(self):
+        self.now = 0.0
+        self.pending = []
+
+    def __call__(self):
+        return self.now
+
+    def at(self, t, callback):
+        self.pending.append((t, callback))
+
+    def sleep(self, seconds):
+        self.now += seconds
+        for item in [p for p in self.pending if p[0] <= self.now]:
+            self.pending.remove(item)
+            item[1]()
+
+
+def test_lookup_pose_polls_in_wall_time_for_a_transform_on_its_way():
     buffer = _buffer_with(_transform("map", "r/base_link", 10.0))
-    late = threading.Timer(0.1, lambda: buffer.set_transform(_transform("map", "r/base_link", 10.2, x=3.0), "test"))
-    late.start()
-    started = time.time()
-    pose, stamp = fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(10.2), 0.1, wall_wait=2.0)
-    late.join()
+    clock = FakeWallClock()
+    clock.at(0.1, lambda: buffer.set_transform(_transform("map", "r/base_link", 10.2, x=3.0), "test"))
+    pose, stamp = fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(10.2), 0.1, wall_wait=2.0,
+                                       clock=clock, sleep=clock.sleep)
     assert pose.x == 3.0 and abs(stamp.to_sec() - 10.2) < 1e-6
-    assert time.time() - started < 1.0
+    assert 0.1 <= clock.now < 0.11          # it returned at the first poll after the transform came
+    clock = FakeWallClock()
     with pytest.raises(fleet_io.StalePose):   # nothing new comes: refused once the wait is over
-        fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(11.0), 0.1, wall_wait=0.05)
+        fleet_io.lookup_pose(buffer, "map", "r/base_link", rospy.Time.from_sec(11.0), 0.1, wall_wait=0.05,
+                             clock=clock, sleep=clock.sleep)
+    assert 0.05 <= clock.now < 0.06
+
+
+def test_stale_scan_is_the_one_rule_of_the_follower_and_the_coordinator():
+    assert fleet_io.stale_scan(10.0, 10.29, 0.3) is None
+    assert fleet_io.stale_scan(10.0, 10.35, 0.3) == "newest scan is 0.35 s old (limit ~max_scan_age 0.30 s)"
+    assert fleet_io.stale_scan(None, 10.0, 0.3) == "no scan yet"
+    # listening since 9.9: no scan yet is not stale until max_age has passed since then
+    assert fleet_io.stale_scan(None, 10.1, 0.3, since=9.9) is None
+    assert fleet_io.stale_scan(None, 10.25, 0.3, since=9.9) == "no scan yet"
 
 
 def test_the_follower_holds_still_and_counts_a_failure_on_an_old_pose(monkeypatch):

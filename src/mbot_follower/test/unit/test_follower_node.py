@@ -236,3 +236,39 @@ def test_a_follower_receives_the_poses_of_the_robots_its_cycle_needs_and_no_othe
     assert n._robots_needed(star) == set(star.slots)                          # every neighbour
     leading = star._replace(leader="follower_1")
     assert n._robots_needed(leading) == {"follower_1"}                         # its move_base drives it
+
+
+def test_overruns_and_late_starts_are_counted_and_published(clock, monkeypatch):
+    """A cycle whose computation takes longer than the period (50 ms) is an overrun; a cycle that
+    the timer starts a period or more after its time is a late start; ~state carries both."""
+    from rospy.timer import TimerEvent
+
+    n = node(clock)
+    n._on_assignment_data(TRIANGLE)
+    t = rospy.Time.from_sec(clock.t)
+
+    def event(late):
+        return TimerEvent(t, t, t, t + rospy.Duration.from_sec(late), None)
+
+    n._cycle(event(0.01))                             # on time, quick
+    msg = n.state_pub.messages[-1]
+    assert (msg.overruns, msg.late_starts) == (0, 0)
+    n._cycle(event(0.05))                             # one period late
+    assert (n.state_pub.messages[-1].overruns, n.state_pub.messages[-1].late_starts) == (0, 1)
+    wall = [1000.0]
+    monkeypatch.setattr(follower_node.time, "time", lambda: wall[0])
+    real_step = n._step
+
+    def slow_step(now):
+        real_publish = n._publish_state
+
+        def later(*args, **kwargs):
+            wall[0] += 0.06                           # 60 ms of computing pass before the state
+            n._publish_state = real_publish
+            return real_publish(*args, **kwargs)
+        n._publish_state = later
+        return real_step(now)
+    n._step = slow_step
+    n._cycle(event(0.0))
+    assert (n.state_pub.messages[-1].overruns, n.state_pub.messages[-1].late_starts) == (1, 1)
+    assert n.state_pub.messages[-1].cycle_time == pytest.approx(0.06)

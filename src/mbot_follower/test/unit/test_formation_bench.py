@@ -92,9 +92,10 @@ def test_the_re_plan_must_drop_the_victim_not_a_robot_whose_name_starts_like_it(
 
 
 def test_a_row_is_the_worst_value_over_the_runs():
-    runs = [{"succeeded": True, "contacts": 0, "switch_s": 4.3, "converge_s": None},
-            {"succeeded": False, "contacts": 2, "switch_s": 6.1, "converge_s": 7.0}]
+    runs = [{"succeeded": True, "contacts": 0, "switch_s": 4.3, "converge_s": None, "overruns": 3, "late_starts": 1},
+            {"succeeded": False, "contacts": 2, "switch_s": 6.1, "converge_s": 7.0, "overruns": 5, "late_starts": None}]
     row = worst(runs)
+    assert (row["overruns"], row["late_starts"]) == (8, 1)   # beside cycle_p99_ms: counted over the runs
     assert row["runs"] == 2 and row["succeeded"] == 1 and row["contacts"] == 2
     assert row["switch_s"] == 6.1 and row["converge_s"] == 7.0 and row["recover_s"] is None
 

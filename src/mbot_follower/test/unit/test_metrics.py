@@ -555,3 +555,23 @@ def test_a_column_on_its_path_slots_around_a_corner_has_no_slot_error(along_path
         # rigid slots swing around the corner: robot_2's is at (1.5, -0.6), 0.85 m away
         assert last.robots["robot_2"].slot_error == pytest.approx(math.hypot(0.6, 0.6))
         assert last.heading_max == pytest.approx(math.pi / 2)
+
+
+def test_overruns_and_late_starts_are_summed_from_each_controllers_newest_counters_and_kept_in_the_files(tmp_path):
+    c = MetricsCollector()
+    c.on_follower_state("robot_1", 1.0, 0.95, True, 10, 0, 0.08, "slot", 1, 0)
+    c.on_follower_state("robot_1", 1.05, 1.0, True, 11, 0, 0.03, "slot", 1, 2)
+    c.on_follower_state("robot_2", 1.0, 0.95, True, 10, 0, 0.09, "slot", 4, 1)
+    s = summarize(c.run)
+    assert (s["fleet"]["cycle_overruns"], s["fleet"]["cycle_late_starts"]) == (5, 3)
+    assert (s["robots"]["robot_1"]["cycle_overruns"], s["robots"]["robot_1"]["cycle_late_starts"]) == (1, 2)
+    RunWriter(str(tmp_path)).write(c.run, s)
+    assert [(r.overruns, r.late_starts) for r in load_run(str(tmp_path)).controller] == [(1, 0), (1, 2), (4, 1)]
+    # a record written before the counters existed still loads (as zeros)
+    path = tmp_path / "controller.csv"
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(",".join(line.split(",")[:7]) for line in lines) + "\n")
+    assert [(r.overruns, r.late_starts) for r in load_run(str(tmp_path)).controller] == [(0, 0)] * 3
+    path.write_text("t_s,robot,latency_s\n")
+    with pytest.raises(RunFileError, match="expected the columns t_s,robot,latency_s,cycle_time_ms"):
+        load_run(str(tmp_path))

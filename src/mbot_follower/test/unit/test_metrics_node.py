@@ -124,3 +124,49 @@ def test_the_live_summary_costs_at_most_its_share_of_a_core_and_the_final_one_is
     assert len(made) == 3
     with open(os.path.join(str(tmp_path), "metrics.json")) as f:
         assert json.load(f)["samples"] == made[-1] > made[0]   # the whole record, to its end
+
+
+def truth(t, x, vx, wz=0.0):
+    import rospy
+    from nav_msgs.msg import Odometry
+
+    msg = Odometry()
+    msg.header.stamp = rospy.Time.from_sec(t)
+    msg.header.frame_id = "map"
+    msg.pose.pose.position.x = x
+    msg.pose.pose.orientation.w = 1.0
+    msg.twist.twist.linear.x, msg.twist.twist.angular.z = vx, wz
+    return msg
+
+
+def test_every_robot_gets_power_and_energy_from_its_measured_velocity_whoever_commands_it(tmp_path, monkeypatch):
+    """No robot has a follower controller here (the leader and robots driven by move_base goals
+    in dispatch mode publish nothing but their ground truth): a driving robot's energy grows by
+    the power model of its velocity, one at rest stays at 0 J; /fleet/metrics has both."""
+    import math
+
+    import rospy
+
+    n = metrics_node.MetricsNode.__new__(metrics_node.MetricsNode)
+    n.collector = MetricsCollector()
+    n.lock = threading.Lock()
+    n.closed = False
+    n.summary_due = 0.0
+    n.pub = Publisher()
+    n.heartbeat_pub = Publisher()
+    n.heartbeat = metrics_node.Header()
+    monkeypatch.setattr(rospy.Time, "now", staticmethod(lambda: rospy.Time.from_sec(10.0)))
+    for k in range(101):             # 10 s at 10 Hz: leader drives 0.3 m/s turning 0.2 rad/s; robot_5 stands
+        t = 1.0 + k * 0.1
+        n.on_truth(truth(t, 0.03 * k, 0.3, 0.2), "leader")
+        n.on_truth(truth(t, 4.0, 0.0), "robot_5")
+    power = 4.0 * 0.3 ** 2 + 0.5 * 0.2 ** 2            # the power model's defaults [W]
+    assert math.isclose(n.collector.energy["leader"], power * 10.0, rel_tol=1e-6)
+    assert n.collector.energy["robot_5"] == 0.0
+    n.publish()
+    msg = n.pub.sent[-1]
+    energy = dict(zip(msg.robots, msg.robot_energy))
+    assert set(energy) == {"leader", "robot_5"}
+    assert math.isclose(energy["leader"], power * 10.0, rel_tol=1e-3) and energy["robot_5"] == 0.0
+    assert dict(zip(msg.robots, msg.robot_power)) == {"leader": power, "robot_5": 0.0}
+    assert math.isclose(msg.energy, power * 10.0, rel_tol=1e-3)
