@@ -340,7 +340,8 @@ class FollowerController(object):
             mode = "merge"
         neighbours = []
         if self.params["controller"] == "consensus":
-            neighbours = self._neighbours(a, now) if frame is ref_map else self._path_neighbours(a, now, frame)
+            neighbours = self._neighbours(a, now, reference) if frame is ref_map else \
+                self._path_neighbours(a, now, frame)
         twist = frame_twist if mode in ("slot", "merge", "detour") else Twist2D(frame_twist.vx, 0.0, 0.0)
         cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
         cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
@@ -444,10 +445,10 @@ class FollowerController(object):
         mine = math.hypot(*a.slots[self.robot])
         return sum(1 for r, s in a.slots.items() if r not in (self.robot, a.leader) and math.hypot(*s) > mine + 1e-6)
 
-    def _slot_relative_to(self, a, reference):
-        """The robot's slot seen from the robot it tracks (slots are given in the leader's frame;
-        the formation is taken to face the way its reference faces)."""
-        sx, sy = a.slots[self.robot]
+    def _slot_relative_to(self, a, reference, robot=None):
+        """The slot of `robot` (default: this one) seen from the robot it tracks (slots are given
+        in the leader's frame; the formation is taken to face the way its reference faces)."""
+        sx, sy = a.slots[robot or self.robot]
         rx, ry = a.slots[reference]
         return sx - rx, sy - ry
 
@@ -538,18 +539,21 @@ class FollowerController(object):
             result.append((relative(frame, pose), (slot.x, slot.y)))
         return result
 
-    def _neighbours(self, a, now):
-        """The other followers' poses in the leader's frame with their slots (for consensus)."""
+    def _neighbours(self, a, now, reference):
+        """The other followers' poses and slots for consensus, in the frame of the robot this one
+        tracks (`reference`: the leader in a star, the robot ahead in a chain), the frame of its
+        own pose and slot: the law compares (pose_j - pose_i) with (slot_j - slot_i), which mixes
+        nothing only when all four are in one frame."""
         result = []
-        for robot, slot in a.slots.items():
+        for robot in a.slots:
             if robot in (self.robot, a.leader):
                 continue
             try:
-                pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % a.leader, "%s/base_link" % robot, now,
+                pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % robot, now,
                                       self.params["max_pose_age"])
             except StalePose:
                 continue
-            result.append((pose, slot))
+            result.append((pose, self._slot_relative_to(a, reference, robot)))
         return result
 
     # --- outputs ------------------------------------------------------------------------------

@@ -272,3 +272,73 @@ def test_overruns_and_late_starts_are_counted_and_published(clock, monkeypatch):
     n._cycle(event(0.0))
     assert (n.state_pub.messages[-1].overruns, n.state_pub.messages[-1].late_starts) == (1, 1)
     assert n.state_pub.messages[-1].cycle_time == pytest.approx(0.06)
+
+
+# --- consensus in a chain: every pose and slot in the frame of the robot followed ----------------
+
+CHAIN = Assignment("leader", "wedge", 1.2,
+                   {"leader": (0.0, 0.0), "follower_1": (-1.0, 0.6), "follower_2": (-2.0, 1.2),
+                    "follower_3": (-2.0, 0.0)},
+                   {"follower_1": "leader", "follower_2": "follower_1", "follower_3": "follower_1"}, False)
+
+
+def place(n, t, poses):
+    for child, (x, y, theta) in poses.items():
+        tf = TransformStamped()
+        tf.header.stamp = rospy.Time.from_sec(t)
+        tf.header.frame_id = "map"
+        tf.child_frame_id = "%s/base_link" % child
+        tf.transform.translation.x, tf.transform.translation.y = x, y
+        tf.transform.rotation.z, tf.transform.rotation.w = math.sin(theta / 2), math.cos(theta / 2)
+        n.tf_buffer.set_transform(tf, "test")
+
+
+def chain_poses(f3_off=0.0):
+    """follower_1 on its slot but turned 60 deg; follower_2 and follower_3 on their slots seen
+    from follower_1 (the chain's rule: the formation faces the way the robot ahead faces)."""
+    from mbot_common.geometry import Pose2D, compose
+
+    f1 = Pose2D(-1.0, 0.6, math.radians(60))
+    f2 = compose(f1, Pose2D(-1.0, 0.6, 0.0))
+    f3 = compose(f1, Pose2D(-1.0 + f3_off, -0.6, 0.0))
+    return {"leader": (0.0, 0.0, 0.0), "follower_1": tuple(f1), "follower_2": tuple(f2), "follower_3": tuple(f3)}
+
+
+def chain_node(clock, controller):
+    n = node(clock)
+    n.robot = "follower_2"
+    n.params["controller"] = controller
+    n.law = follower_node.make_control_law(controller)
+    n._on_assignment_data(CHAIN)
+    clock.set(clock.t + 0.05)     # node() put the triangle's poses at the old time: these are newer
+    return n
+
+
+def test_consensus_neighbours_in_a_chain_are_in_the_frame_of_the_robot_followed(clock):
+    n = chain_node(clock, "consensus")
+    place(n, clock.t, chain_poses())
+    now = rospy.Time.from_sec(clock.t)
+    neighbours = n._neighbours(CHAIN, now, "follower_1")
+    assert len(neighbours) == 2                       # follower_1 and follower_3, not the leader nor itself
+    for pose, slot in neighbours:                     # every neighbour on its slot, seen from follower_1
+        assert (pose.x, pose.y) == pytest.approx(slot, abs=1e-6)
+    assert sorted(slot for _, slot in neighbours) == pytest.approx([(-1.0, -0.6), (0.0, 0.0)])
+
+
+def test_the_consensus_law_runs_in_the_node_and_acts_only_on_a_neighbours_error(clock):
+    """The node's cycle (tf in, cmd_vel and ~state out) with the consensus law against slot
+    tracking: the same command while every neighbour is on its slot (the chain's frames agree),
+    a different one when follower_3 is 0.5 m off its slot."""
+    commands = {}
+    for controller in ("slot_tracking", "consensus"):
+        for off in (0.0, 0.5):
+            n = chain_node(clock, controller)
+            place(n, clock.t, chain_poses(off))
+            n._on_scan(scan(clock.t))
+            n._cycle(None)
+            assert last_mode(n) == "slot"
+            c = n.cmd_pub.messages[-1]
+            commands[controller, off] = (c.linear.x, c.linear.y, c.angular.z)
+    assert commands["consensus", 0.0] == pytest.approx(commands["slot_tracking", 0.0], abs=1e-9)
+    assert commands["slot_tracking", 0.5] == pytest.approx(commands["slot_tracking", 0.0], abs=1e-9)
+    assert commands["consensus", 0.5] != pytest.approx(commands["consensus", 0.0], abs=1e-3)
