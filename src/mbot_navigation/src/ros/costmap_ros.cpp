@@ -485,7 +485,8 @@ CostmapRos::CostmapRos(const std::string& name, const CostmapRosSettings& settin
 void CostmapRos::subscribeScans()
 {
   if (obstacle_layer_ || moving_layer_)
-    scan_sub_ = nh_.subscribe(settings_.scan_topic, 10, &CostmapRos::scanCallback, this);
+    scan_sub_ = nh_.subscribe(settings_.scan_topic, 10, &CostmapRos::scanCallback, this,
+                              ros::TransportHints().tcpNoDelay());  // no Nagle wait between hosts
 }
 
 void CostmapRos::stop()

@@ -125,7 +125,7 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
   action_goal_pub_ = nh_.advertise<move_base_msgs::MoveBaseActionGoal>("move_base/goal", 1);
   simple_goal_sub_ = nh_.subscribe("move_base_simple/goal", 1, &NavNode::onSimpleGoal, this);
   odom_topic_ = params.odom_topic;
-  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this);
+  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this, ros::TransportHints().tcpNoDelay());
   make_plan_srv_ = private_nh_.advertiseService("make_plan", &NavNode::onMakePlan, this);
   clear_costmaps_srv_ = private_nh_.advertiseService("clear_costmaps", &NavNode::onClearCostmaps, this);
   server_ = std::make_unique<ActionServer>(nh_, "move_base", false);
@@ -327,7 +327,7 @@ void NavNode::wake()
 {
   if (!asleep_) return;
   tf_listener_ = SharedTf::listen();
-  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this);
+  odom_sub_ = nh_.subscribe(odom_topic_, 1, &NavNode::onOdom, this, ros::TransportHints().tcpNoDelay());
   velocity_ = Twist2D();  // until the odometry comes
   teammates_->start();
   if (discovery_timer_.isValid())

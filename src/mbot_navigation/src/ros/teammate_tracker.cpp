@@ -39,7 +39,8 @@ void TeammateTracker::subscribe(const std::string& name, Mate& mate)
 {
   const std::string topic = "/" + name + (source_ == Source::GROUND_TRUTH ? "/base_pose_ground_truth" : "/odom");
   mate.sub = nh_.subscribe<nav_msgs::Odometry>(
-      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; });
+      topic, 1, [this, name](const nav_msgs::Odometry::ConstPtr& msg) { mates_[name].last = msg; }, ros::VoidConstPtr(),
+      ros::TransportHints().tcpNoDelay());
 }
 
 void TeammateTracker::stop()
