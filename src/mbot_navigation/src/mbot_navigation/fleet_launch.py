@@ -53,7 +53,8 @@ def fleet_launch_xml(world, localization="fake", base_global_planner="astar", co
         (it sleeps while it has no goal: a formation's followers cost almost nothing)
     :param nav_manager: True: the nav nodes are nodelets in one nodelet manager (manager_name(),
         a worker thread per robot; each robot keeps its ``/<robot>/move_base`` loader process,
-        which is not required: killing it unloads only that robot); False: a process per robot
+        which is not required: killing it unloads only that robot); False (the default: with
+        sleeping nav nodes the loaders cost what the manager saves; README "Cost"): a process per robot
     """
     if localization not in LOCALIZATIONS:
         raise ValueError("localization: expected one of %s, got %r" % (", ".join(LOCALIZATIONS), localization))
