@@ -226,7 +226,6 @@ class Hosts(object):
         self.count = count
         self.prefix = prefix
         self.switch = "%s-sw" % prefix
-        self.made_etc_netns = False
         self.link = None           # the user-space switch's process (no kernel netem)
         self.quickack = quickack
 
@@ -261,9 +260,7 @@ class Hosts(object):
             _ip("netns", "add", self.switch)
             _ip("-n", self.switch, "link", "add", "br0", "type", "bridge")
             _ip("-n", self.switch, "link", "set", "br0", "up")
-            if not os.path.isdir("/etc/netns"):
-                os.makedirs("/etc/netns")
-                self.made_etc_netns = True
+            os.makedirs("/etc/netns", exist_ok=True)
             text = hosts_file(self.count)
             for k in range(1, self.count + 1):
                 ns = self.ns(k)
@@ -330,8 +327,12 @@ class Hosts(object):
                 for name in os.listdir(path):
                     os.remove(os.path.join(path, name))
                 os.rmdir(path)
-        if self.made_etc_netns and os.path.isdir("/etc/netns") and not os.listdir("/etc/netns"):
-            os.rmdir("/etc/netns")
+        # made by the first of several runs, which may end before the others: the last one removes it
+        if os.path.isdir("/etc/netns") and not os.listdir("/etc/netns"):
+            try:
+                os.rmdir("/etc/netns")
+            except OSError:
+                pass  # another run made its hosts file meanwhile
 
 
 def existing_hosts(prefix):
