@@ -306,7 +306,8 @@ class CoordinatorNode(object):
         self.leader_scan = None
         self._scan_robot = leader
         self._scan_since = now
-        self._scan_sub = rospy.Subscriber("/%s/scan" % leader, LaserScan, self._on_scan, queue_size=1)
+        self._scan_sub = rospy.Subscriber("/%s/scan" % leader, LaserScan, self._on_scan, queue_size=1,
+                                          tcp_nodelay=True)  # no Nagle wait between hosts
 
     def _obstacle_ahead(self, leader, now):
         """Why the fleet must pause for what is in front of the leader (a str), or False. The

@@ -113,7 +113,8 @@ class FollowerController(object):
         self.state_pub = rospy.Publisher("~state", FollowerState, queue_size=10)
         rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=1)
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=1)
-        rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1)
+        # tcp_nodelay: between hosts Nagle would hold a scan (several TCP segments) for the delayed ACK
+        rospy.Subscriber("scan", LaserScan, self._on_scan, queue_size=1, tcp_nodelay=True)
         rospy.Subscriber("/map", OccupancyGrid, self._on_map, queue_size=1)
         self.timer = rospy.Timer(rospy.Duration(1.0 / self.params["rate"]), quiet_at_shutdown(self._cycle))
         rospy.loginfo("%s: follower controller (%s) ready", rospy.get_name(), self.params["controller"])
@@ -234,7 +235,8 @@ class FollowerController(object):
             self._leader_sub_name = source
             self.leader_twist = Twist2D(0.0, 0.0, 0.0)
             self._leader_odom_sub = rospy.Subscriber(
-                "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, source, queue_size=1)
+                "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, source, queue_size=1,
+                tcp_nodelay=True)
 
     def _on_status(self, msg):
         with self.lock:

@@ -67,7 +67,7 @@ from mbot_common.strict_yaml import Reader
 
 FORMATION_NAMES = ("line", "column", "triangle", "wedge", "rectangle", "diamond", "circle")
 TOPOLOGIES = ("star", "chain")
-MAX_ROBOTS = 20          # more is a mistake for this fleet, not a formation
+MAX_ROBOTS = 60          # as many as a run may have (mbot_bringup fleet_world): 40 for the scale benchmark
 MIN_SLOT_DISTANCE = 0.5  # custom slots must be at least this far apart [spacing]
 
 ALONG_PATH = ("column",)  # the built-in formations whose slots follow the leader's path

@@ -107,7 +107,8 @@ class MetricsNode(object):
             return
         rospy.loginfo("%s: measuring %s", rospy.get_name(), robot)
         self.subs[robot] = [
-            rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth, robot, queue_size=200),
+            rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth, robot, queue_size=200,
+                             tcp_nodelay=True),
             rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self.on_state, robot,
                              queue_size=100),
             rospy.Subscriber("/%s/move_base/global_plan" % robot, Path, self.on_plan, robot, queue_size=5),

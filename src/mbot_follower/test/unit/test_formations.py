@@ -138,7 +138,7 @@ def test_unknown_name_lists_the_known_ones():
     ("triangle", 2, "formation 'triangle' takes at least 3 robots, got 2"),
     ("diamond", 3, "formation 'diamond' takes at least 4 robots, got 3"),
     ("line", 1, "formation 'line' takes at least 2 robots, got 1"),
-    ("column", MAX_ROBOTS + 1, "formation 'column' takes at most 20 robots, got 21"),
+    ("column", MAX_ROBOTS + 1, "formation 'column' takes at most 60 robots, got 61"),
     ("rectangle", 5, "formation 'rectangle' takes an even number of robots (4, 6, 8, ...), got 5"),
 ])
 def test_robot_counts_the_shape_does_not_take(name, n, says):
