@@ -38,7 +38,17 @@ from mbot_bringup.scenario import (CRITERIA, Timeline, TimelineConfig, check_aga
 from mbot_common.strict_yaml import ConfigError
 
 WALL_PER_SIM = 20.0        # a run gives up after time_limit x this + START_WALL wall seconds
-START_WALL = 180.0         # [s wall] for the fleet to come up
+START_WALL = 180.0         # [s wall] for a fleet of up to START_ROBOTS robots to come up
+START_ROBOTS = 20
+START_WALL_PER_ROBOT = 6.0  # [s wall] more per robot beyond: 40 robots took 177 s on 2 cores
+
+
+def start_wall(robots):
+    """How long [s wall] a fleet of `robots` robots may take to come up: every robot's processes
+    start on the same cores (a 40-robot fleet starts about 200 processes)."""
+    return START_WALL + START_WALL_PER_ROBOT * max(0, robots - START_ROBOTS)
+
+
 STATUS_PERIOD = 10.0       # [s wall] a new status line when the output is not a terminal
 STATE_EVENTS = {"FORMING": "forming", "NAVIGATING": "navigating", "ARRIVED": "arrived", "DEGRADED": "degraded",
                 "ABORTED": "aborted"}
@@ -296,11 +306,13 @@ class ScenarioPlayer(object):
 
     # --- start ---------------------------------------------------------------------------------
 
-    def wait_ready(self, wall_timeout=START_WALL):
-        """Wait (wall time) until every robot, its controller and move_base answer (formation
-        mode: and the coordinator); then the scenario's clock starts."""
+    def wait_ready(self, wall_timeout=None):
+        """Wait (wall time, start_wall() for this fleet unless given) until every robot, its
+        controller and move_base answer (formation mode: and the coordinator); then the
+        scenario's clock starts."""
         from mbot_navigation.move_base_client import connect_move_base
 
+        wall_timeout = wall_timeout or start_wall(len(self.robots))
         if self.scenario.mode == "formation":
             self.probe.wait_for_fleet(wall_timeout)
         else:

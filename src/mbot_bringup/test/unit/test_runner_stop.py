@@ -1,6 +1,6 @@
-"""The scenario runner stops every process of the fleet it started, also the nodes roslaunch put
-in sessions of their own, which a process group kill misses (an interrupted 40-robot run left
-150 nav and localization nodes running)."""
+"""The scenario runner gives a large fleet more time to come up, and stops every process of the
+fleet it started, also the nodes roslaunch put in sessions of their own, which a process group
+kill misses (an interrupted 40-robot run left 150 nav and localization nodes running)."""
 import os
 import subprocess
 import sys
@@ -45,3 +45,10 @@ def test_a_pid_used_again_is_not_stopped():
     finally:
         sleeper.kill()
         sleeper.wait()
+
+
+def test_a_larger_fleet_gets_longer_to_come_up():
+    from mbot_bringup.scenario_runner import START_WALL, start_wall
+
+    assert start_wall(3) == start_wall(20) == START_WALL
+    assert start_wall(40) == START_WALL + 20 * 6.0  # 177 s measured for 40 robots on 2 cores
