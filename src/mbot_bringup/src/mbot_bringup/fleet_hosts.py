@@ -32,6 +32,8 @@ import sys
 import threading
 import time
 
+from mbot_bringup.scenario_runner import descendants
+
 SUBNET = "10.77.0"                 # host k: SUBNET.k/24
 NETEM = "delay 20ms 10ms loss 0.5%"
 HOST_NAME = "mbot-h%d"             # resolvable inside the namespaces
@@ -103,33 +105,6 @@ def _cmdline(pid):
             return [a.decode("utf-8", "replace") for a in f.read().split(b"\0") if a]
     except OSError:
         return []
-
-
-def _children():
-    """{parent pid: [child pids]} of every process now."""
-    children = {}
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open("/proc/%s/stat" % entry) as f:
-                stat = f.read()
-        except OSError:
-            continue
-        ppid = int(stat[stat.rindex(")") + 2:].split()[1])
-        children.setdefault(ppid, []).append(int(entry))
-    return children
-
-
-def descendants(pid):
-    """The pids below `pid` (children, their children, ...)."""
-    children = _children()
-    found, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            found.append(child)
-            todo.append(child)
-    return found
 
 
 def find_master_port(pid):

@@ -26,19 +26,10 @@ import rostest
 from actionlib_msgs.msg import GoalStatus
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
+from nav_test_tools import ErrorLog
+
 RACE = "Got a transition callback on a goal handle that we're not tracking"
 SERVER = "plain/move_base"
-
-
-class ErrorLog(logging.Handler):
-    """The ERROR (and worse) records that rospy logs in this process."""
-
-    def __init__(self):
-        logging.Handler.__init__(self, logging.ERROR)
-        self.records = []
-
-    def emit(self, record):
-        self.records.append(record.getMessage())
 
 
 def goal():

@@ -1,6 +1,7 @@
 """Helpers shared by the navigation rostests (test/nav_*.py): goals, the robot's ground-truth
 track, the simulator's contacts and the map. Everything waits in sim time; rostest's time-limit
 (wall time) catches a simulator that stopped."""
+import logging
 import math
 import threading
 
@@ -39,6 +40,18 @@ def run_goal(client, goal, timeout):
         client.wait_for_result(rospy.Duration(5.0))
         return None, "no result within %.0f sim s" % timeout, (rospy.Time.now() - start).to_sec()
     return client.get_state(), client.get_goal_status_text(), (rospy.Time.now() - start).to_sec()
+
+
+class ErrorLog(logging.Handler):
+    """The ERROR (and worse) records that rospy logs in this process; attach it to the "rosout"
+    logger."""
+
+    def __init__(self):
+        logging.Handler.__init__(self, logging.ERROR)
+        self.records = []
+
+    def emit(self, record):
+        self.records.append(record.getMessage())
 
 
 class Track(object):

@@ -18,7 +18,7 @@ from actionlib_msgs.msg import GoalStatus, GoalStatusArray
 from geometry_msgs.msg import PoseStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
-from nav_test_tools import Track, angle_diff, wait_until
+from nav_test_tools import ErrorLog, Track, angle_diff, wait_until
 
 
 def movebase_client():
@@ -41,17 +41,6 @@ def movebase_client():
         rospy.signal_shutdown("Action server not available!")
     else:
         return client.get_result(), client.get_state(), client.get_goal_status_text()
-
-
-class ErrorLog(logging.Handler):
-    """The ERROR (and worse) records that rospy logs in this process."""
-
-    def __init__(self):
-        logging.Handler.__init__(self, logging.ERROR)
-        self.records = []
-
-    def emit(self, record):
-        self.records.append(record.getMessage())
 
 
 class TutorialClient(unittest.TestCase):
