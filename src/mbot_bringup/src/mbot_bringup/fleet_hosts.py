@@ -32,7 +32,7 @@ import sys
 import threading
 import time
 
-from mbot_bringup.scenario_runner import descendants
+from mbot_bringup.processes import descendants
 
 SUBNET = "10.77.0"                 # host k: SUBNET.k/24
 NETEM = "delay 20ms 10ms loss 0.5%"

@@ -33,6 +33,7 @@ import sys
 import threading
 import time
 
+from mbot_bringup.processes import descendants, start_time, stop_pids
 from mbot_bringup.scenario import (CRITERIA, Timeline, TimelineConfig, check_against_world, evaluate, load_scenario,
                                    loss_detection_times, scenario_window, summary_lines)
 from mbot_common.strict_yaml import ConfigError
@@ -649,57 +650,6 @@ def prepare_run_dir(run_dir):
             raise ConfigError("%s: not empty and not a run dir (no scenario.yaml): choose another --run-dir" % run_dir)
         shutil.rmtree(run_dir)
     os.makedirs(run_dir, exist_ok=True)
-
-
-def descendants(pid):
-    """PIDs of every living process below `pid`, by the parent links in /proc. roslaunch starts
-    each node in a session of its own (a process group kill misses them), and a node that runs a
-    launch of its own (fleet_navigation, formation_fleet) has children too."""
-    children = {}
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open("/proc/%s/stat" % entry) as f:
-                ppid = int(f.read().rsplit(")", 1)[1].split()[1])
-        except (OSError, IndexError, ValueError):
-            continue  # gone meanwhile
-        children.setdefault(ppid, []).append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            found.append(child)
-            todo.append(child)
-    return found
-
-
-def start_time(pid):
-    """When process `pid` started (clock ticks since boot), None when it is gone: with the PID it
-    names one process (a PID can be used again)."""
-    try:
-        with open("/proc/%d/stat" % pid) as f:
-            return int(f.read().rsplit(")", 1)[1].split()[19])
-    except (OSError, IndexError, ValueError):
-        return None
-
-
-def stop_pids(pids, wait=5.0):
-    """SIGTERM to each of `pids` ([(pid, start_time(pid))]) still alive, SIGKILL to those alive
-    `wait` s later."""
-    def alive(entry):
-        return start_time(entry[0]) == entry[1] is not None
-
-    for sig, pause in ((signal.SIGTERM, wait), (signal.SIGKILL, 0.0)):
-        left = [entry for entry in pids if alive(entry)]
-        for pid, _ in left:
-            try:
-                os.kill(pid, sig)
-            except OSError:
-                pass
-        deadline = time.time() + pause
-        while left and time.time() < deadline:
-            time.sleep(0.1)
-            left = [entry for entry in left if alive(entry)]
 
 
 class FleetLaunch(object):

@@ -6,7 +6,7 @@ import subprocess
 import sys
 import time
 
-from mbot_bringup.scenario_runner import descendants, start_time, stop_pids
+from mbot_bringup.processes import descendants, start_time, stop_pids
 
 
 def test_the_whole_tree_is_found_and_stopped_also_in_other_sessions():
