@@ -443,6 +443,26 @@ def test_while_the_leader_waits_a_moments_excuse_does_not_send_it_off():
     assert core.update(t, off, heard(t), excused=["follower_1"]) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
 
 
+def test_after_a_regroup_the_leader_drives_a_while_before_it_waits_again():
+    """trio_wall hung for 180 s: a follower held by its safety layer was excused, the leader drove
+    on, the next cycle the hold was over (the follower 0.4 m off its slot) and the leader waited
+    again, so it never moved."""
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
+    assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
+    t += 0.1 + core.config.excuse_time + 0.05
+    core.update(t - core.config.excuse_time, off, heard(t), excused=["follower_1"])
+    assert core.update(t, off, heard(t), excused=["follower_1"]) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
+    # the hold is over, the follower still 1 m off: the leader drives on for regroup_min_drive
+    for k in range(1, 20):
+        now = t + k * 0.1
+        assert core.update(now, off, heard(now), leader_nav="ACTIVE") == [], k
+    now = t + core.config.regroup_min_drive + 0.05
+    assert core.update(now, off, heard(now), leader_nav="ACTIVE") == [("cancel", "leader")]
+
+
 def test_regrouping_gives_up_after_its_timeout():
     core = make()
     t, poses, _ = formed_and_navigating(core)
