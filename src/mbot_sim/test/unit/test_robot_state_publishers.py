@@ -1,13 +1,17 @@
 """Plain tests (pytest, no master) of the robot_state_publishers helper's logic."""
+import math
 import os
 import sys
+
+import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "src"))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "mbot_description", "src"))
 
-from mbot_sim.robot_state_publishers import (RobotStatePublishers, plan_changes,  # noqa: E402
-                                             prefixed_description, robot_set)
+from mbot_sim.robot_state_publishers import (FixedFramesPublisher, RobotStatePublishers,  # noqa: E402
+                                             fixed_joints, plan_changes, prefixed_description,
+                                             quaternion_from_rpy, robot_set)
 
 DESCRIPTION_DIR = os.path.join(HERE, "..", "..", "..", "mbot_description")
 
@@ -69,13 +73,43 @@ def test_update_sets_descriptions_launches_and_stops():
     assert launcher.processes[1].stopped
 
 
-def test_publishers_ignore_joint_states_unless_asked():
-    """The simulator publishes the wheels' tf: robot_state_publisher must not also read
-    joint_states (each message costs it three master calls); with use_joint_states it does."""
-    launcher = FakeLauncher()
-    RobotStatePublishers(launcher, {}.__setitem__, {}.pop, DESCRIPTION_DIR).update({"robot_0": "mbot"})
-    assert launcher.launched[0].remap_args == [("joint_states", RobotStatePublishers.UNUSED_JOINT_STATES)]
-    launcher = FakeLauncher()
-    RobotStatePublishers(launcher, {}.__setitem__, {}.pop, DESCRIPTION_DIR,
-                         use_joint_states=True).update({"robot_0": "mbot"})
-    assert launcher.launched[0].remap_args == []
+def test_quaternion_from_rpy_is_urdfs_fixed_axis_order():
+    s = math.sqrt(0.5)
+    assert quaternion_from_rpy(0.0, 0.0, math.pi / 2) == pytest.approx((0.0, 0.0, s, s))
+    assert quaternion_from_rpy(math.pi / 2, 0.0, 0.0) == pytest.approx((s, 0.0, 0.0, s))
+    # R = Rz(90) Rx(90) maps the body's z axis to (1, 0, 0) (Rx: z -> -y, Rz: -y -> +x)
+    x, y, z, w = quaternion_from_rpy(math.pi / 2, 0.0, math.pi / 2)
+    v = (2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y))
+    assert v == pytest.approx((1.0, 0.0, 0.0), abs=1e-12)
+
+
+def test_fixed_joints_are_the_urdfs_fixed_joints_with_their_origins():
+    joints = fixed_joints(prefixed_description(DESCRIPTION_DIR, "mbot", "robot_7"))
+    by_child = {child: (parent, xyz, q) for parent, child, xyz, q in joints}
+    assert sorted(by_child) == ["robot_7/base_laser", "robot_7/base_link", "robot_7/caster"]
+    parent, xyz, q = by_child["robot_7/base_laser"]
+    assert parent == "robot_7/base_link"
+    assert xyz == pytest.approx((0.05, 0.0, 0.12))  # laser_joint in mbot.urdf
+    assert q == pytest.approx((0.0, 0.0, 0.0, 1.0))
+    assert all("wheel" not in child for child in by_child)  # the wheels move: the simulator's
+    with pytest.raises(ValueError, match="joint j origin xyz"):
+        fixed_joints('<robot name="r"><joint name="j" type="fixed"><parent link="a"/><child link="b"/>'
+                     '<origin xyz="1 2"/></joint></robot>')
+
+
+def test_fixed_frames_of_every_robot_in_one_message_sent_again_when_the_fleet_changes():
+    params, sent = {}, []
+    pubs = FixedFramesPublisher(sent.append, params.__setitem__, params.pop, DESCRIPTION_DIR, lambda: 12.5)
+    pubs.update({"robot_0": "mbot", "robot_1": "mbot_omni"})
+    assert sorted(params) == ["/robot_0/robot_description", "/robot_1/robot_description"]
+    assert len(sent) == 1
+    children = sorted(t[1] for t in sent[0])
+    assert "robot_0/base_laser" in children and "robot_1/base_laser" in children
+    assert all(t[4] == 12.5 for t in sent[0])
+    pubs.update({"robot_0": "mbot", "robot_1": "mbot_omni"})
+    assert len(sent) == 1  # nothing changed, nothing sent
+    pubs.update({"robot_1": "mbot_omni", "robot_2": "mbot"})
+    assert len(sent) == 2
+    assert "/robot_0/robot_description" not in params
+    children = {t[1].split("/")[0] for t in sent[1]}
+    assert children == {"robot_1", "robot_2"}
