@@ -101,6 +101,8 @@ def parse_args(argv):
                         help="true: the simulator runs in lockstep (longer tf waits cost no sim time)")
     parser.add_argument("--robots", default="", help="a,b: only these robots' stacks (a fleet across hosts); "
                                                      "empty: every robot of the world")
+    parser.add_argument("--nav-host", default=False, type=launch_bool,
+                        help="true: one fleet_host process loads this host's nav nodes and fake localizations")
     parser.add_argument("--no-map-server", action="store_true",
                         help="leave out the map server (it runs on the first host)")
     return parser.parse_args([a for a in argv if ":=" not in a])
@@ -124,7 +126,7 @@ def main(argv=None):
         # shutdown_costmaps: only the leader drives with its nav node; the others sleep (no laser,
         # costmaps or tf) until the coordinator sends one of them a goal as the new leader.
         text = fleet_launch_xml(world, args.localization, config_dir=args.config_dir, output=args.output,
-                                robots=robots, shutdown_costmaps=True,
+                                robots=robots, shutdown_costmaps=True, nav_host=args.nav_host,
                                 extra_lines=controller_lines(world, args.controller, args.output,
                                                              args.controller_config, args.leader_max_vel,
                                                              args.lockstep, robots))

@@ -3,24 +3,9 @@
 #include <exception>
 
 #include <ros/ros.h>
-#include <rosgraph_msgs/Log.h>
 
 #include "mbot_navigation/ros/nav_node.h"
-
-namespace
-{
-/// Wait (wall time, at most `timeout`) until /rosout has a subscriber. Messages logged before
-/// roscpp has connected to rosout never reach it, and the start-up lines (unknown keys, a bad
-/// value) matter most.
-void waitForRosout(ros::NodeHandle& nh, double timeout)
-{
-  // The same publication as rosconsole's: roscpp shares one per topic within a process.
-  ros::Publisher rosout = nh.advertise<rosgraph_msgs::Log>("/rosout", 1);
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (rosout.getNumSubscribers() == 0 && ros::WallTime::now() < deadline && ros::ok())
-    ros::WallDuration(0.01).sleep();
-}
-}  // namespace
+#include "mbot_navigation/ros/wait_for_rosout.h"
 
 int main(int argc, char** argv)
 {
@@ -28,7 +13,7 @@ int main(int argc, char** argv)
   // Held until main returns: when the last NodeHandle dies, roscpp shuts the node down and with
   // it the console, so the fatal line below would print nowhere.
   ros::NodeHandle nh;
-  waitForRosout(nh, 3.0);
+  mbot_navigation::waitForRosout(nh, 3.0);
   std::unique_ptr<mbot_navigation::NavNode> node;
   try
   {

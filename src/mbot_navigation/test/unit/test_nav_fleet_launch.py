@@ -113,3 +113,29 @@ def test_nav_manager_and_shutdown_costmaps_options(tmp_path):
         fleet_launch_xml(world, shutdown_costmaps="yes")
     with pytest.raises(ValueError, match="nav_manager: expected True or False, got 1"):
         fleet_launch_xml(world, nav_manager=1)
+
+
+def test_nav_host_loads_every_nav_node_and_fake_localization_in_one_process(tmp_path):
+    import yaml
+
+    world = read_world(write(tmp_path, "three.world.yaml", "map: %s\nrobots:\n" % OFFICE_MAP
+                             + "".join("  - {name: r%d, pose: [%d, 0, 0]}\n" % (i, i) for i in range(3))))
+    root = ET.fromstring(fleet_launch_xml(world, nav_host=True, robots=["r2", "r0"]))
+    nodes = root.findall("node")
+    assert [(n.get("pkg"), n.get("type"), n.get("name"), n.get("required")) for n in nodes] == [
+        ("mbot_navigation", "fleet_host", "nav_host_r2", "true")]
+    nodelets = yaml.safe_load(nodes[0].find("rosparam").text)
+    assert nodelets == [{"name": "/r0/move_base", "type": "mbot_navigation/NavNodelet"},
+                        {"name": "/r0/fake_localization", "type": "mbot_localization/FakeLocalization"},
+                        {"name": "/r2/move_base", "type": "mbot_navigation/NavNodelet"},
+                        {"name": "/r2/fake_localization", "type": "mbot_localization/FakeLocalization"}]
+    navs = [{a.get("name"): a.get("value") for a in i.findall("arg")} for i in root.findall("include")
+            if i.get("file").endswith("/navigation.launch")]
+    assert [(a["robot"], a["host"]) for a in navs] == [("r0", "nav_host_r2"), ("r2", "nav_host_r2")]
+    # a particle filter is no nodelet: it stays a process of its own (navigation.launch starts it)
+    root = ET.fromstring(fleet_launch_xml(world, nav_host=True, localization="pf"))
+    assert "fake_localization" not in root.find("node").find("rosparam").text
+    with pytest.raises(ValueError, match="nav_manager and nav_host: choose one"):
+        fleet_launch_xml(world, nav_host=True, nav_manager=True)
+    with pytest.raises(ValueError, match="nav_host: expected True or False"):
+        fleet_launch_xml(world, nav_host="true")
