@@ -20,8 +20,10 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 (something in their way, e.g. a lost robot standing still), are excused: the leader's waiting
 would not bring them closer. While the leader waits, an excuse counts once it has lasted
 ``excuse_time``: a follower turning away from a wall is held by its safety layer for a moment,
-and that moment must not send the leader off without it. Once it drives on, the leader drives
-``regroup_min_drive`` at least before it waits again. A waiting leader is never paused (it
+and that moment must not send the leader off without it. A regroup that starts within
+``regroup_rejoin`` of the end of one continues it: its ``regroup_timeout`` counts from the first
+(a follower whose excuse ends as soon as the leader drives again would otherwise stop it every
+cycle, for ever). A waiting leader is never paused (it
 has no goal): a follower passing in front of it to its slot is not an obstacle to go around.
 
 Except right after a formation switch on the move: the followers change places, and on the way they
@@ -114,7 +116,7 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
-        self.regroup_min_drive = 2.0               # after a regroup the leader drives this long at least [s]
+        self.regroup_rejoin = 1.0                  # a regroup this soon after one ended continues it [s]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
@@ -178,6 +180,7 @@ class FleetCoordinator(object):
         self._lost_at = {}
         self._last_leader_pose = None        # where the leader was last seen (for a replacement)
         self._regroup_since = None           # the leader waits for the followers since then
+        self._regroup_ended = (-1e9, None)   # (when the last regroup ended, when it had begun)
         self._excused_since = {}             # follower -> since when it is excused (regrouping)
         self._no_regroup_before = -1e9
         self._trail = Trail()                # the leader's path since the assignment (path slots)
@@ -387,7 +390,8 @@ class FleetCoordinator(object):
         if self._regroup_since is None:
             if worst is None or worst[1] <= self.config.regroup_error or now < self._no_regroup_before:
                 return None
-            self._regroup_since = now
+            ended, began = self._regroup_ended
+            self._regroup_since = began if now - ended <= self.config.regroup_rejoin else now
             self._switch_fast = False  # a follower lags: not faster again in this switch
             self.reason = "regrouping: the leader waits for %s (%.2f m off its slot)" % worst
             self.events.append((now, "regroup", self.reason))
@@ -395,12 +399,11 @@ class FleetCoordinator(object):
         timed_out = now - self._regroup_since > self.config.regroup_timeout
         if worst is not None and worst[1] >= self.config.resume_error and not timed_out:
             return []
+        self._regroup_ended = (now, self._regroup_since)
         self._regroup_since = None
         self._switch_waits = False  # once: a follower that cannot reach its slot is excused again
-        # A follower whose excuse or error flickers about the limits would stop the leader again
-        # in the next cycle, every time: a leader that never drives frees nobody (trio_wall hung
-        # for 180 s so, a follower held by another that followed the leader's trail).
-        self._no_regroup_before = now + (self.config.regroup_timeout if timed_out else self.config.regroup_min_drive)
+        if timed_out:
+            self._no_regroup_before = now + self.config.regroup_timeout
         if beside_lost:
             held = beside_lost[0]
             self.reason = "driving on: only that frees %s's slot, %s" % (held, self._blocked_by[held])

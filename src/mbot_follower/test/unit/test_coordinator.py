@@ -443,24 +443,51 @@ def test_while_the_leader_waits_a_moments_excuse_does_not_send_it_off():
     assert core.update(t, off, heard(t), excused=["follower_1"]) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
 
 
-def test_after_a_regroup_the_leader_drives_a_while_before_it_waits_again():
+def test_stop_and_go_regroups_count_as_one_and_time_out():
     """trio_wall hung for 180 s: a follower held by its safety layer was excused, the leader drove
     on, the next cycle the hold was over (the follower 0.4 m off its slot) and the leader waited
-    again, so it never moved."""
+    again, every cycle. Regroups that follow each other within regroup_rejoin are one: after
+    regroup_timeout in all the leader drives on, and does not wait again for regroup_timeout."""
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
+    goal = ("goal", "leader", Pose2D(5.0, 0.0, 0.0))
+    start = t + 0.1
+    assert core.update(start, off, heard(start), leader_nav="ACTIVE") == [("cancel", "leader")]
+    now, cycles = start, 0
+    while now - start < core.config.regroup_timeout - 2.0:
+        # held for excuse_time: the leader drives on; the next cycle the hold is over: it waits again
+        seen = []
+        while goal not in seen and len(seen) < 15:
+            now += 0.1
+            seen += core.update(now, off, heard(now), excused=["follower_1"])
+        assert seen == [goal], now - start
+        now += 0.1
+        assert core.update(now, off, heard(now), leader_nav="ACTIVE") == [("cancel", "leader")]
+        cycles += 1
+    assert cycles >= 5
+    # regroup_timeout after the first wait: the leader drives on for good
+    now = start + core.config.regroup_timeout + 0.05
+    assert core.update(now, off, heard(now), leader_nav=None) == [goal]
+    assert "after 15 s of regrouping" in core.reason
+    for k in range(1, 50):
+        assert core.update(now + 0.1 * k, off, heard(now + 0.1 * k), leader_nav="ACTIVE") == [], k
+
+
+def test_a_regroup_long_after_the_last_one_is_a_new_one():
     core = make()
     t, poses, _ = formed_and_navigating(core)
     off = dict(poses)
     off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
     assert core.update(t + 0.1, off, heard(t + 0.1), leader_nav="ACTIVE") == [("cancel", "leader")]
-    t += 0.1 + core.config.excuse_time + 0.05
-    core.update(t - core.config.excuse_time, off, heard(t), excused=["follower_1"])
-    assert core.update(t, off, heard(t), excused=["follower_1"]) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]
-    # the hold is over, the follower still 1 m off: the leader drives on for regroup_min_drive
-    for k in range(1, 20):
-        now = t + k * 0.1
-        assert core.update(now, off, heard(now), leader_nav="ACTIVE") == [], k
-    now = t + core.config.regroup_min_drive + 0.05
-    assert core.update(now, off, heard(now), leader_nav="ACTIVE") == [("cancel", "leader")]
+    t += 10.0
+    assert core.update(t, poses, heard(t)) == [("goal", "leader", Pose2D(5.0, 0.0, 0.0))]  # back in its slot
+    t += core.config.regroup_rejoin + 0.1
+    assert core.update(t, off, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    # a new regroup: it may last regroup_timeout from now, not from the first
+    t += core.config.regroup_timeout - 1.0
+    assert core.update(t, off, heard(t)) == []
 
 
 def test_regrouping_gives_up_after_its_timeout():
