@@ -377,7 +377,8 @@ def wait_stack_ready(master_uri, timeout):
 def record_nodes(master_uri, host_of, out, timeout):
     """(On host 1) wait until every robot's move_base and follower_controller are registered and
     write where each registered from (the host name in its URI; `host_of`: {robot: host name}
-    expected) to `out` (JSON)."""
+    expected) to `out` (JSON). A robot's move_base is the node that publishes
+    ``/<robot>/move_base/status``: its own process, or the host's ``fleet_host`` that loaded it."""
     from urllib.parse import urlparse
 
     import rosgraph
@@ -388,10 +389,17 @@ def record_nodes(master_uri, host_of, out, timeout):
     found = {}
     end = time.time() + timeout
     while time.time() < end and len(found) < len(expected):
+        try:
+            publishers = dict(master.getSystemState()[0])
+        except Exception:  # noqa: B902 (no master any more)
+            publishers = {}
         for node in expected:
             if node not in found:
+                provider = node
+                if node.endswith("/move_base"):
+                    provider = (publishers.get(node + "/status") or [node])[0]
                 try:
-                    found[node] = urlparse(master.lookupNode(node)).hostname
+                    found[node] = urlparse(master.lookupNode(provider)).hostname
                 except Exception:  # noqa: B902 (not registered yet, or no master any more)
                     pass
         time.sleep(1.0)
