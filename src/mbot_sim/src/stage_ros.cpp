@@ -50,6 +50,9 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
     throw StartupError(pnh.resolveName("base_watchdog_timeout") + ": expected a number > 0 [s]");
   pnh.param("marker_rate", p.marker_rate, 10.0);
   if (!(p.marker_rate > 0.0)) throw StartupError(pnh.resolveName("marker_rate") + ": expected a number > 0 [Hz]");
+  pnh.param("clock_rate", p.clock_rate, 0.0);
+  if (!(p.clock_rate >= 0.0))
+    throw StartupError(pnh.resolveName("clock_rate") + ": expected a number >= 0 [Hz] (0: /clock after every step)");
   pnh.param("wheel_tf_rate", p.wheel_tf_rate, 10.0);
   if (!(p.wheel_tf_rate >= 0.0))
     throw StartupError(pnh.resolveName("wheel_tf_rate") + ": expected a number >= 0 [Hz] (0: no wheel transforms)");
@@ -291,7 +294,18 @@ void StageRos::run()
       tf_batch_.reserve(tf->transforms.size());
       tf_pub_.publish(tf);
     }
-    publishClock();
+    // Every node wakes for each /clock message (rospy handles each in Python): ~clock_rate below the
+    // physics rate spares the fleet's nodes that work. A lockstep boundary always gets its /clock:
+    // the controllers' timers fire on it, and sim time waits there for their commands.
+    const double t = world_->time();
+    const bool at_boundary = params_.lockstep && t + 1e-9 >= next_boundary_;
+    const bool went_back = params_.clock_rate > 0.0 && t + 1.0 / params_.clock_rate < next_clock_time_ - 1e-9;  // reset
+    if (params_.clock_rate <= 0.0 || at_boundary || went_back || t + 1e-9 >= next_clock_time_)
+    {
+      publishClock();
+      if (params_.clock_rate > 0.0)
+        next_clock_time_ = (std::floor((t + 1e-9) * params_.clock_rate) + 1.0) / params_.clock_rate;
+    }
     if (params_.lockstep) noteBoundary();
     // Markers are for eyes: at ~marker_rate in sim time, at most 30 Hz wall, only while someone listens.
     if (world_->time() + 1e-9 >= next_marker_time_ && ros::WallTime::now() >= next_marker_wall_ &&

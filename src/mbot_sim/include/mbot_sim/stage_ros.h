@@ -58,6 +58,8 @@ struct StageParams
   int seed = 0;                                 ///< ~seed: overrides the world file's when set
   double watchdog_timeout = 0.2;                ///< ~base_watchdog_timeout [s sim time]
   double marker_rate = 10.0;                    ///< ~marker_rate: /stage/markers for moving obstacles [Hz sim time]
+  double clock_rate = 0.0;                      ///< ~clock_rate: /clock at most this often [Hz sim time], on
+                                                ///< multiples of its period and at lockstep boundaries; 0: every step
   double wheel_tf_rate = 10.0;                  ///< ~wheel_tf_rate: <ns>/base_link -> <ns>/<wheel> on /tf [Hz sim
                                                 ///< time]; 0: not published (robot_state_publisher from joint_states)
   bool lockstep = false;                        ///< ~lockstep: hold sim time at period boundaries for the controllers
@@ -170,6 +172,7 @@ private:
   ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom and wheel transforms
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all transforms of one step
   double next_marker_time_ = 0.0;
+  double next_clock_time_ = 0.0;  ///< ~clock_rate: /clock when sim time reaches this
   ros::WallTime next_marker_wall_;
 
   // lockstep (see waitForControllers())
