@@ -21,9 +21,11 @@ corridor). Followers that follow the leader's trail past a wall, or that their s
 would not bring them closer. While the leader waits, an excuse counts once it has lasted
 ``excuse_time``: a follower turning away from a wall is held by its safety layer for a moment,
 and that moment must not send the leader off without it. A regroup that starts within
-``regroup_rejoin`` of the end of one continues it: its ``regroup_timeout`` counts from the first
-(a follower whose excuse ends as soon as the leader drives again would otherwise stop it every
-cycle, for ever). A waiting leader is never paused (it
+``regroup_rejoin`` of the end of one that ended on an excuse (a follower still off its slot)
+continues it: its ``regroup_timeout`` counts from the first (a follower whose excuse ends as soon
+as the leader drives again would otherwise stop it every cycle, for ever). After a regroup that
+ended with every follower back in its slot, a new one is a new one: at a sharp turn the leader
+waits, turns a little, waits again, and each wait has its full time. A waiting leader is never paused (it
 has no goal): a follower passing in front of it to its slot is not an obstacle to go around.
 
 Except right after a formation switch on the move: the followers change places, and on the way they
@@ -116,7 +118,7 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
-        self.regroup_rejoin = 1.0                  # a regroup this soon after one ended continues it [s]
+        self.regroup_rejoin = 1.0                  # a regroup this soon after one that ended on an excuse continues it [s]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
@@ -399,7 +401,10 @@ class FleetCoordinator(object):
         timed_out = now - self._regroup_since > self.config.regroup_timeout
         if worst is not None and worst[1] >= self.config.resume_error and not timed_out:
             return []
-        self._regroup_ended = (now, self._regroup_since)
+        # ended on an excuse: an excused or blocked follower is still off its slot
+        all_errors = self._regroup_errors(now, poses)
+        on_excuse = any(all_errors.get(r, 0.0) >= self.config.resume_error for r in excused)
+        self._regroup_ended = (now, self._regroup_since) if on_excuse else (-1e9, None)
         self._regroup_since = None
         self._switch_waits = False  # once: a follower that cannot reach its slot is excused again
         if timed_out:

@@ -475,6 +475,26 @@ def test_stop_and_go_regroups_count_as_one_and_time_out():
         assert core.update(now + 0.1 * k, off, heard(now + 0.1 * k), leader_nav="ACTIVE") == [], k
 
 
+def test_a_regroup_soon_after_one_that_ended_in_formation_is_a_new_one():
+    # a sharp turn: the leader waits, the followers catch up, it turns a little, waits again
+    core = make()
+    t, poses, _ = formed_and_navigating(core)
+    off = dict(poses)
+    off["follower_1"] = Pose2D(poses["follower_1"].x - 1.0, poses["follower_1"].y, 0.0)
+    goal = ("goal", "leader", Pose2D(5.0, 0.0, 0.0))
+    start = t
+    for k in range(6):
+        t += 0.1
+        assert core.update(t, off, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")], k
+        t += 2.5
+        assert core.update(t, poses, heard(t)) == [goal]  # back in its slot
+    assert t - start > core.config.regroup_timeout
+    t += 0.1
+    assert core.update(t, off, heard(t), leader_nav="ACTIVE") == [("cancel", "leader")]
+    t += core.config.regroup_timeout - 1.0
+    assert core.update(t, off, heard(t)) == []  # still waiting: this regroup began 14 s ago
+
+
 def test_a_regroup_long_after_the_last_one_is_a_new_one():
     core = make()
     t, poses, _ = formed_and_navigating(core)
