@@ -118,7 +118,7 @@ class CoordinatorConfig(object):
         self.regroup_error = 0.35                  # a follower this far off its slot: the leader waits [m]
         self.resume_error = 0.15                   # ... until every follower is this close again [m]
         self.regroup_timeout = 15.0                # ... or this long has passed [s]
-        self.regroup_rejoin = 1.0                  # a regroup this soon after one that ended on an excuse continues it [s]
+        self.regroup_rejoin = 1.0                  # a regroup this soon after one that ended on an excuse: the same [s]
         self.excuse_time = 1.0                     # ... or the rest have been excused this long [s]
         self.free_hold = 3.0                       # a slot that was in a wall counts this long after [s]
         self.switch_room_ahead = 3.0               # free map this far ahead: the leader drives through a switch [m]
