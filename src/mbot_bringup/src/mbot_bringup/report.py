@@ -27,6 +27,7 @@ from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_data import METRIC_BY_KEY, METRICS, STATES, LabCriteria, ReportError, arrival_time, \
     assignments, compare_rows, evaluate, format_value, parse_criteria, run_numbers, sorted_events, \
     switch_settling, target_time
+from mbot_bringup.scenario import LAB_THRESHOLDS, criteria_reasons
 from mbot_bringup.report_demo import write_report  # noqa: F401  (the demo's report: scripts/demo, fleet_office)
 
 IMAGES = "report"   # the images' folder, beside index.html
@@ -152,15 +153,28 @@ def _threshold_text(name, c):
     return format_value(name, c.threshold)
 
 
+def _looser(c, lab):
+    return lab is not None and not isinstance(lab, bool) and not isinstance(c.threshold, bool) and \
+        (c.threshold < lab if c.op == ">=" else c.op == "<=" and c.threshold > lab)
+
+
 def criteria_table(inputs):
+    """The criteria with the lab's threshold beside the run's and, for a looser one, the
+    scenario file's reason (scenario.yaml's `why:`)."""
+    why = criteria_reasons(inputs.scenario_file) if os.path.isfile(inputs.scenario_file) else {}
     rows = []
     for c in inputs.criteria:
         metric = METRIC_BY_KEY.get(c.name)   # None: a criterion of the runner's own
         label, unit = (metric.label, metric.unit) if metric else (c.name, "")
+        lab = LAB_THRESHOLDS.get(c.name)
+        lab_text = "" if lab is None else _threshold_text(c.name, c._replace(threshold=lab))
+        reason = why.get(c.name, "(no reason given)") if _looser(c, lab) else ""
         rows.append(([esc(label), "<code>%s</code>" % esc(c.name), esc(format_value(c.name, c.value)), esc(c.op),
-                      esc(_threshold_text(c.name, c)), esc(unit), "PASS" if c.passed else "FAIL"],
+                      esc(_threshold_text(c.name, c)), esc(lab_text), esc(unit), "PASS" if c.passed else "FAIL",
+                      esc(reason)],
                      "pass" if c.passed else "fail"))
-    out = table(["criterion", "key", "value", "", "threshold", "unit", "result"], rows, left=2)
+    out = table(["criterion", "key", "value", "", "threshold", "lab's", "unit", "result", "why looser than the lab"],
+                rows, left=2)
     if inputs.facts:
         out += "<p>What the scenario runner saw: %s.</p>" % esc(", ".join(
             "%s = %s" % (k, _fact(v)) for k, v in sorted(inputs.facts.items())))

@@ -90,6 +90,11 @@ FORMATION_DEFAULTS = {
     "tf_success_rate": 0.9999,
     "contacts": 0,
 }
+#: The lab's thresholds (the defaults above, and docs/formation_benchmark.md's targets: a switch
+#: within 6 s, DEGRADED within 2 s). A scenario may set a looser one only with a reason:
+#: `NAME: {value: V, why: TEXT}`; the report shows both thresholds and the reason.
+LAB_THRESHOLDS = dict(FORMATION_DEFAULTS, max_switch_time_s=6.0, max_loss_detection_s=2.0,
+                      max_time_to_degraded_s=2.0)
 #: Dispatch scenarios: every goal reached (goals_reached is set to the number of goals), no contact.
 DISPATCH_DEFAULTS = {"finished": True, "failed_steps": 0, "contacts": 0}
 
@@ -157,6 +162,7 @@ class Scenario(object):
         self.end = "arrived"
         self.timeline = []           # [Step]
         self.criteria = {}           # name -> threshold
+        self.criteria_why = {}       # name -> why a threshold is looser than the lab's
 
     def steps(self, action):
         return [s for s in self.timeline if s.action == action]
@@ -317,8 +323,37 @@ def _read_criteria(r, mode, scenario):
             continue
         number = "an integer" if kind is int else "a number"
         what = "true or false" if kind is bool else "%s (%s %s)" % (number, op, what)
-        criteria[name] = cr.required(name, kind, what=what)
+        why = ""
+        if isinstance(value, dict):     # {value, why}: a threshold looser than the lab's, with its reason
+            vr = cr.child(name)
+            vr.check_keys(["value", "why"], required=["value", "why"])
+            threshold = vr.required("value", kind, what=what)
+            why = vr.required("why", str, what="a reason (text)", check=lambda v: v.strip() != "").strip()
+        else:
+            threshold = cr.required(name, kind, what=what)
+        lab = LAB_THRESHOLDS.get(name)
+        looser = lab is not None and kind is not bool and (threshold < lab if op == ">=" else threshold > lab)
+        if looser and not why:
+            cr.fail(name, "%s %g is looser than the lab's %s %g: say why ({value: %g, why: ...})"
+                    % (op, threshold, op, lab, threshold))
+        if why and not looser:
+            cr.fail(name, "a why: is for a threshold looser than the lab's (%s %s), and %g is not"
+                    % (op, "none" if lab is None else "%g" % lab, threshold))
+        criteria[name] = threshold
+        if why:
+            scenario.criteria_why[name] = why
     return criteria
+
+
+def criteria_reasons(path):
+    """{criterion: why} of a scenario file's widened thresholds ({} when it has none or cannot
+    be read: the report shows what it can)."""
+    try:
+        data = load_yaml(path)
+    except (ConfigError, IOError, OSError):
+        return {}
+    crit = data.get("criteria") if isinstance(data, dict) else None
+    return dict((k, str(v["why"])) for k, v in (crit or {}).items() if isinstance(v, dict) and "why" in v)
 
 
 def load_scenario(path):

@@ -5,7 +5,8 @@ import os
 
 import pytest
 
-from mbot_bringup.scenario import (CRITERIA, FORMATION_DEFAULTS, Timeline, TimelineConfig, check, check_against_world,
+from mbot_bringup.scenario import (CRITERIA, FORMATION_DEFAULTS, LAB_THRESHOLDS, Timeline, TimelineConfig, check,
+                                   check_against_world, criteria_reasons,
                                    evaluate, load_scenario, loss_detection_times, scenario_window, summary_lines,
                                    switch_times)
 from mbot_common.strict_yaml import ConfigError
@@ -54,6 +55,8 @@ def test_every_key_and_action_is_read():
     expected = dict(FORMATION_DEFAULTS, steady_navigating_slot_rms_m=0.2, switches=2, max_recovery_time_s=10)
     del expected["tf_success_rate"]
     assert s.criteria == expected
+    assert s.criteria_why == {"steady_navigating_slot_rms_m": "a wider formation in a test of the reader"}
+    assert criteria_reasons(fixture("valid_every_action.yaml")) == s.criteria_why
 
 
 def test_dispatch_mode_counts_its_goals():
@@ -81,6 +84,13 @@ def test_the_shipped_scenarios_read():
     for name in names:
         s = load_scenario(os.path.join(SCENARIOS, name + ".yaml"))
         assert s.description, "%s: say what the scenario shows" % name
+        # every threshold looser than the lab's says why, and the lab's stay the defaults
+        looser = [n for n, v in s.criteria.items() if n in LAB_THRESHOLDS and not isinstance(v, bool)
+                  and (v < LAB_THRESHOLDS[n] if CRITERIA[n][0] == ">=" else v > LAB_THRESHOLDS[n])]
+        assert sorted(s.criteria_why) == sorted(looser), name
+        assert criteria_reasons(s.path) == s.criteria_why
+    assert load_scenario(os.path.join(SCENARIOS, "triangle_trio.yaml")).criteria["latency_p95_s"] == \
+        FORMATION_DEFAULTS["latency_p95_s"] == LAB_THRESHOLDS["latency_p95_s"]
 
 
 def test_the_scenario_is_checked_against_the_run_robots():
