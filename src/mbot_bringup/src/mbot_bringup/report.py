@@ -27,6 +27,7 @@ from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_data import METRIC_BY_KEY, METRICS, STATES, LabCriteria, ReportError, arrival_time, \
     assignments, compare_rows, evaluate, format_value, parse_criteria, run_numbers, sorted_events, \
     switch_settling, target_time
+from mbot_bringup.report_scans import read_scans
 from mbot_bringup.scenario import LAB_THRESHOLDS, criteria_reasons
 from mbot_bringup.report_demo import write_report  # noqa: F401  (the demo's report: scripts/demo, fleet_office)
 
@@ -330,7 +331,9 @@ def render_images(inputs, image_dir, animation=True):
     out["speeds.png"] = plots.plot_speeds(run, colors, os.path.join(image_dir, "speeds.png"))
     if animation:
         path = os.path.join(image_dir, ANIMATION)
-        plots.write_animation(run, inputs.world, colors, path, radius)
+        bag = os.path.join(inputs.run_dir, "run.bag")
+        scans = read_scans(bag, run.robots) if os.path.isfile(bag) else None
+        plots.write_animation(run, inputs.world, colors, path, radius, scans)
         out[ANIMATION] = path
     return out, colors
 

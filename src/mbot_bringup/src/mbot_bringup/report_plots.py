@@ -409,8 +409,23 @@ def gif_writer(fps):
         return animation.ImageMagickWriter(fps=fps)
 
 
-def write_animation(run, world, colors, path, radius):
-    """A GIF of the run: the map, robots as discs with a heading tick, their slots as dashed
+def frame_scans(series, scans, i):
+    """{robot: points (n x 2) in the map frame} of each robot's newest scan at frame i (report_scans),
+    placed with the robot's pose of the scan's time."""
+    from mbot_bringup.report_scans import in_map, scan_at
+    out = {}
+    for r in series.robots:
+        found = scan_at(scans or {}, r, series.t[i] + series.t0)
+        # the pose of the scan's time; the frame's when that sample missed the robot
+        pose = found and (series.pose(r, _index_at(series, found[0] - series.t0)) or series.pose(r, i))
+        if found is not None and pose is not None:
+            out[r] = in_map(found[1], pose)
+    return out
+
+
+def write_animation(run, world, colors, path, radius, scans=None):
+    """A GIF of the run: the map, each robot's laser hits as dots (scans: report_scans.read_scans,
+    None: none), robots as discs with a heading tick, their slots as dashed
     rings (a dotted line from each robot to its slot: its slot error), a line from the leader to
     each follower, each robot's recent path, the state, the formation and the time as the
     caption, and each event for a few seconds after it. Returns the number of frames."""
@@ -432,9 +447,10 @@ def write_animation(run, world, colors, path, radius):
         disc = Circle((0, 0), radius, facecolor=colors[r], edgecolor="black", lw=0.8, zorder=6)
         tick, = ax.plot([], [], "-", color="black", lw=1.5, zorder=7)
         name = ax.text(0, 0, r, fontsize=8, ha="center", va="bottom", zorder=8, color=colors[r])
+        hits, = ax.plot([], [], ".", color=colors[r], ms=2.0, alpha=0.7, zorder=2)
         ax.add_patch(slot)
         ax.add_patch(disc)
-        artists[r] = (trail, slot, error, link, disc, tick, name)
+        artists[r] = (trail, slot, error, link, disc, tick, name, hits)
     caption = ax.set_title("", fontsize=10, family="monospace")
     news = ax.text(0.01, 0.02, "", transform=ax.transAxes, fontsize=10, color=STYLE.mark_colors["switch"],
                    zorder=9, bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85))
@@ -451,7 +467,9 @@ def write_animation(run, world, colors, path, radius):
             a = assignment_at(assigned, t + series.t0)
             slots = slot_positions(a, leader, leader_trail(series, a, i) if a is not None and a.along_path else None)
             recent = (series.t >= t - STYLE.trail) & (series.t <= t)
-            for r, (trail, slot, error, link, disc, tick, name) in artists.items():
+            seen = frame_scans(series, scans, i)
+            for r, (trail, slot, error, link, disc, tick, name, hits) in artists.items():
+                hits.set_data(seen[r][:, 0] if r in seen else [], seen[r][:, 1] if r in seen else [])
                 pose = series.pose(r, i)
                 lost = r in series.lost[i]
                 visible = pose is not None
