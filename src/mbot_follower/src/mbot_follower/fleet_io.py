@@ -7,6 +7,7 @@ hold the clock it waits for. So a lookup takes the newest transform and refuses 
 older than a bound, after polling for a newer one for a moment of wall time.
 """
 import functools
+import math
 import threading
 from collections import namedtuple
 
@@ -84,6 +85,20 @@ class CachedParams(object):
         return dict(rospy.get_param_cached(self._key, {}))
 
 
+def twist_between(first, second):
+    """(vx, vy, wz) in the robot's frame that takes the odometry pose `first` to `second`, each
+    (x, y, theta, t [s]); None when they are not in time order. The simulator's odometry pose is its
+    twist integrated, so two poses 0.02 s apart give the twist of /odom without receiving it."""
+    dt = second[3] - first[3]
+    if not dt > 0.0:
+        return None
+    turn = math.atan2(math.sin(second[2] - first[2]), math.cos(second[2] - first[2]))
+    heading = first[2] + 0.5 * turn   # the chord of an arc lies along the mean heading
+    dx, dy = second[0] - first[0], second[1] - first[1]
+    c, s = math.cos(heading), math.sin(heading)
+    return ((c * dx + s * dy) / dt, (-s * dx + c * dy) / dt, turn / dt)
+
+
 class RobotTfListener(object):
     """A tf2 Buffer filled with the poses of chosen robots only: ``/<robot>/tf_pose`` of the fleet
     tf relay (mbot_localization's fleet_tf_relay: each robot's map -> odom -> base_footprint) and
@@ -91,7 +106,11 @@ class RobotTfListener(object):
     fleet's /tf in Python, every follower every robot: a cost that grows with the square of the
     fleet. Lookups in the buffer are the same as with the listener.
 
-    source "tf" makes it a plain tf2_ros.TransformListener (every robot; no relay needed)."""
+    source "tf" makes it a plain tf2_ros.TransformListener (every robot; no relay needed).
+
+    With the relay it also keeps each followed robot's twist from its last two odometry poses
+    (``twist(robot)``): a follower then needs no subscription to the leader's /odom (50 Hz of
+    messages with two 6 x 6 covariances, for three numbers)."""
 
     def __init__(self, buffer, source="relay", topic="tf_pose"):
         import rospy
@@ -108,6 +127,8 @@ class RobotTfListener(object):
         self._since = {}          # robot -> the clock at its first message
         self._lock = threading.Lock()
         self._last_update = 0.0   # [s] the clock at the newest message
+        self._odom = {}           # robot -> its newest odometry pose (x, y, theta, t)
+        self._twist = {}          # robot -> (vx, vy, wz) between its last two odometry poses
         if source == "tf":
             self._listener = tf2_ros.TransformListener(buffer)
         else:
@@ -123,6 +144,8 @@ class RobotTfListener(object):
             for robot in set(self._subs) - set(robots):
                 self._subs.pop(robot).unregister()
                 self._since.pop(robot, None)
+                self._odom.pop(robot, None)
+                self._twist.pop(robot, None)
             for robot in set(robots) - set(self._subs):
                 self._subs[robot] = rospy.Subscriber("/%s/%s" % (robot, self.topic), self._msg, self._on_tf,
                                                      robot, queue_size=100, tcp_nodelay=True)
@@ -141,6 +164,12 @@ class RobotTfListener(object):
         with self._lock:
             return set(self._subs)
 
+    def twist(self, robot):
+        """(vx, vy, wz) of `robot` from its last two odometry poses, or None (none yet, or not
+        followed through the relay)."""
+        with self._lock:
+            return self._twist.get(robot)
+
     def _on_tf(self, msg, robot=None):
         import rospy
 
@@ -153,6 +182,19 @@ class RobotTfListener(object):
         self._last_update = now
         for t in msg.transforms:
             self.buffer.set_transform(t, "fleet_tf_relay")
+            if robot is not None and t.child_frame_id == robot + "/base_footprint":
+                pose = (t.transform.translation.x, t.transform.translation.y, yaw_of(t.transform.rotation),
+                        t.header.stamp.to_sec())
+                with self._lock:
+                    last = self._odom.get(robot)
+                    if last is not None and pose[3] < last[3]:   # a reset: start again
+                        self._twist.pop(robot, None)
+                    elif last is not None:
+                        twist = twist_between(last, pose)
+                        if twist is not None:
+                            self._twist[robot] = twist
+                    if last is None or pose[3] != last[3]:
+                        self._odom[robot] = pose
 
     def _on_static(self, msg):
         for t in msg.transforms:

@@ -232,8 +232,11 @@ class FollowerController(object):
         if self._leader_sub_name != source:
             if self._leader_odom_sub is not None:
                 self._leader_odom_sub.unregister()
+                self._leader_odom_sub = None
             self._leader_sub_name = source
             self.leader_twist = Twist2D(0.0, 0.0, 0.0)
+            if self._tf is not None and self._tf.source == "relay":
+                return   # its twist comes with its poses (RobotTfListener.twist), read each cycle
             self._leader_odom_sub = rospy.Subscriber(
                 "/%s/odom" % source, self._msg["Odometry"], self._on_leader_odom, source, queue_size=1,
                 tcp_nodelay=True)
@@ -290,6 +293,9 @@ class FollowerController(object):
             needed = self._robots_needed(a)
             self._tf.follow(needed)
             tf_warm = self._tf.warm(needed, now.to_sec(), 2.0 * self.params["max_pose_age"])
+            if self._tf.source == "relay" and self._leader_sub_name is not None:
+                twist = self._tf.twist(self._leader_sub_name)
+                self.leader_twist = Twist2D(*twist) if twist is not None else Twist2D(0.0, 0.0, 0.0)
         if a is None or self.robot not in a.slots:
             # Not (yet) in the formation: stand still. The command also tells the simulator's
             # lockstep to wait for this node, so sim time cannot run away from the fleet.

@@ -1,4 +1,6 @@
 """The ROS-side helpers the nodes share (fleet_io.py) that run without a master."""
+import math
+
 import pytest
 import rospy
 
@@ -200,3 +202,22 @@ def test_a_robot_followed_only_now_is_not_looked_up_until_its_poses_have_come_in
 def test_the_robot_tf_listener_refuses_an_unknown_source():
     with pytest.raises(ValueError, match="expected relay or tf"):
         fleet_io.RobotTfListener(None, source="all")
+
+
+def test_twist_between_two_odometry_poses_is_the_twist_in_the_robots_frame():
+    from mbot_follower.fleet_io import twist_between
+
+    # heading 90 deg, 0.01 m along +y in 0.02 s: 0.5 m/s forward
+    assert twist_between((1.0, 2.0, math.pi / 2, 10.0), (1.0, 2.01, math.pi / 2, 10.02)) == pytest.approx(
+        (0.5, 0.0, 0.0), abs=1e-9)
+    # an omni robot facing +x moving along +y: sideways
+    assert twist_between((0.0, 0.0, 0.0, 0.0), (0.0, 0.01, 0.0, 0.02)) == pytest.approx((0.0, 0.5, 0.0), abs=1e-9)
+    # an arc: 1 rad/s at 0.5 m/s for 0.02 s (chord along the mean heading)
+    w, v, dt = 1.0, 0.5, 0.02
+    end = ((v / w) * math.sin(w * dt), (v / w) * (1.0 - math.cos(w * dt)), w * dt, dt)
+    vx, vy, wz = twist_between((0.0, 0.0, 0.0, 0.0), end)
+    assert wz == pytest.approx(1.0, abs=1e-9)
+    assert math.hypot(vx, vy) == pytest.approx(v, rel=1e-4) and abs(vy) < 1e-6
+    # across +-pi
+    assert twist_between((0.0, 0.0, math.pi - 0.01, 0.0), (0.0, 0.0, -math.pi + 0.01, 0.02))[2] == pytest.approx(1.0)
+    assert twist_between((0.0, 0.0, 0.0, 1.0), (1.0, 0.0, 0.0, 1.0)) is None   # same stamp
