@@ -1,0 +1,41 @@
+#include "mbot_coordination/planner.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "mbot_coordination/sipp.h"
+
+namespace mbot_coordination
+{
+PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& options)
+{
+  checkInstance(inst);
+  const auto t0 = Clock::now();
+  PlannerOptions pp_options = options;
+  pp_options.time_limit_s = options.time_limit_s * std::clamp(options.pp_share, 0.0, 1.0);
+  PlanResult result = PrioritizedPlanner().solve(inst, pp_options);
+  if (!result.solved)
+  {
+    PlannerOptions rest = options;
+    rest.time_limit_s = options.time_limit_s - std::chrono::duration<double>(Clock::now() - t0).count();
+    const std::string pp_message = result.message;
+    result = LacamPlanner().solve(inst, rest);
+    result.message = "pp: " + pp_message + (result.solved ? "" : "; lacam: " + result.message);
+  }
+  result.runtime_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+std::vector<std::string> plannerNames() { return {"pp", "lacam", "auto"}; }
+
+std::unique_ptr<Planner> makePlanner(const std::string& name)
+{
+  if (name == "pp") return std::make_unique<PrioritizedPlanner>();
+  if (name == "lacam") return std::make_unique<LacamPlanner>();
+  if (name == "auto") return std::make_unique<AutoPlanner>();
+  std::string known;
+  for (const auto& n : plannerNames()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown MAPF algorithm '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace mbot_coordination
