@@ -1,7 +1,8 @@
 """Node ``metrics_collector``: the ROS side of the formation metrics (the numbers are metrics.py).
 
 Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts``, ``/map`` (is a slot
-in a wall?) and per robot
+in a wall?), ``/stage/markers`` (the simulator's static obstacles, spawned ones too: a slot beside
+one is blocked as beside a wall; recorded as events) and per robot
 ``/<ns>/base_pose_ground_truth`` (frame map), ``/<ns>/follower_controller/state``,
 and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
 robot that appears in an assignment (subscribed when it first appears).
@@ -27,12 +28,14 @@ import rospy
 from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
 from nav_msgs.msg import OccupancyGrid, Odometry, Path
 from std_msgs.msg import Header
+from visualization_msgs.msg import MarkerArray
 
 from mbot_common.geometry import yaw_of
 from mbot_common.params import read_params
 from mbot_follower.fleet_io import assignment_from_msg, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter, summarize
+from mbot_follower.metrics.obstacles import from_markers
 
 #: The live summary (/fleet/metrics, metrics.json while the run goes) goes over the whole record,
 #: so its cost grows with the run: it is computed again only after 1 / SUMMARY_SHARE times its
@@ -98,6 +101,7 @@ class MetricsNode(object):
             rospy.Subscriber("/fleet/status", FleetStatus, self.on_status, queue_size=10),
             rospy.Subscriber("/contacts", Contact, self.on_contact, queue_size=100),
             rospy.Subscriber("/map", OccupancyGrid, self.on_map, queue_size=1),
+            rospy.Subscriber("/stage/markers", MarkerArray, self.on_markers, queue_size=5),
         ]
         for robot in robots:
             self.attach(robot)
@@ -130,6 +134,16 @@ class MetricsNode(object):
         free_space = FreeSpace.from_grid_msg(msg, self.collector.config.slot_clearance)
         with self.lock:
             self.collector.free_space = free_space
+
+    def on_markers(self, msg):
+        """The simulator's static obstacles, at the stamp of their markers (stage_node stamps a
+        spawn's or removal's markers with its sim time)."""
+        stamps = [m.header.stamp for m in msg.markers if not m.header.stamp.is_zero()]
+        t = stamps[0].to_sec() if stamps else rospy.get_time()
+        obstacles = from_markers(msg.markers)
+        with self.lock:
+            if not self.closed:
+                self.collector.on_obstacles(t, obstacles)
 
     def on_status(self, msg):
         with self.lock:

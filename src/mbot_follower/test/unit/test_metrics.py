@@ -575,3 +575,81 @@ def test_overruns_and_late_starts_are_summed_from_each_controllers_newest_counte
     path.write_text("t_s,robot,latency_s\n")
     with pytest.raises(RunFileError, match="expected the columns t_s,robot,latency_s,cycle_time_ms"):
         load_run(str(tmp_path))
+
+
+def test_a_slot_beside_a_spawned_box_is_blocked_as_beside_a_wall(tmp_path):
+    """A column drives east along y = 0 with no map walls near; at 1 s a 0.4 x 0.4 m box is
+    spawned at (3, 0), its long side across the way. The follower's slot (1 m behind the leader)
+    comes within slot_clearance (0.25 m) of the box for x in [2.55, 3.45], i.e. t in [7.1, 8.9] at
+    0.5 m/s; the follower drives around it 0.8 m off its slot (7.2-9 s), else 0.1 m. The box is
+    an event, the slot's samples beside it are blocked, and the steady RMS counts the follower
+    again free_hold (3 s) after its slot is clear: only the 0.1 m samples. Removed at 11 s, the
+    box blocks nothing more. Without the box in the rule the steady RMS would count the detour."""
+    from mbot_follower.free_space import FreeSpace
+    from mbot_follower.metrics.obstacles import Obstacle, blocks, distance
+
+    box = Obstacle("box_1", "box", 3.0, 0.0, 0.0, 0.4, 0.4, 0.0)
+    assert distance(box, 3.0, 0.0) == 0.0 and distance(box, 3.45, 0.0) == pytest.approx(0.25)
+    assert distance(Obstacle("b", "box", 0.0, 0.0, math.pi / 2, 1.0, 0.2, 0.0), 0.0, 0.6) == pytest.approx(0.1)
+    assert distance(Obstacle("c", "cylinder", 0.0, 0.0, 0.0, 0.0, 0.0, 0.3), 0.0, 1.0) == pytest.approx(0.7)
+    assert blocks([box], 3.0, 0.44, 0.25) and not blocks([box], 3.0, 0.46, 0.25)
+
+    def run(with_box):
+        free = FreeSpace(np.zeros((40, 200), dtype=np.int8), 0.1, (-2.0, -2.0), 0.25)   # no walls
+        c = MetricsCollector(MetricsConfig(free_hold=3.0), free)
+        c.on_assignment(0.0, wedge({"robot_0": (0.0, 0.0), "robot_1": (-1.0, 0.0)}, "column"))
+        c.on_status(0.0, "NAVIGATING", "", [])
+
+        def events(t):
+            if with_box and near(t, 1.0):
+                c.on_obstacles(t, [box])
+            if with_box and near(t, 11.0):
+                c.on_obstacles(t, [])
+
+        def poses(t):
+            lx = 0.5 * t
+            error = 0.8 if 7.2 <= t < 9.0 else 0.1   # around the box (its edge 0.2 m + the robot)
+            return {"robot_0": (lx, 0.0, 0.0), "robot_1": (lx - 1.0, error, 0.0)}
+
+        drive(c, 0.0, 16.0, poses, at=events)
+        return c
+
+    c = run(with_box=True)
+    s = summarize(c.run)["fleet"]
+    assert [(e.t, e.kind, e.name, e.x, e.y) for e in c.run.events if e.kind.startswith("obstacle")] == \
+        [(1.0, "obstacle", "box_1", 3.0, 0.0), (11.0, "obstacle_removed", "box_1", 3.0, 0.0)]
+    assert [e.detail for e in c.run.events if e.kind == "obstacle"] == ["box 0.4 x 0.4 m, yaw 0 rad"]
+    blocked = [x.t for x in c.run.samples if x.robots["robot_1"].slot_free == 0.0]
+    assert blocked[0] == pytest.approx(7.1, abs=0.11) and blocked[-1] == pytest.approx(8.9, abs=0.11)
+    assert s["steady_navigating_slot_rms_m"] == pytest.approx(0.1)
+    assert s["slot_blocked_share"] > 0.1
+    without = summarize(run(with_box=False).run)["fleet"]
+    assert without["steady_navigating_slot_rms_m"] > 0.25 and without["slot_blocked_share"] == 0.0
+
+    # the events survive the files, and the summary read back is the same
+    RunWriter(str(tmp_path / "run")).write(c.run, summarize(c.run))
+    back = load_run(str(tmp_path / "run"))
+    assert [e for e in back.events if e.kind.startswith("obstacle")] == \
+        [e for e in c.run.events if e.kind.startswith("obstacle")]
+    assert summarize(back) == summarize(c.run)
+
+
+def test_static_obstacles_are_read_from_the_simulators_markers():
+    """/stage/markers: a CUBE and a CYLINDER in namespace "obstacles" are a box and a cylinder;
+    moving obstacles, robots, names and the DELETEALL marker are not obstacles."""
+    from types import SimpleNamespace as NS
+
+    from mbot_follower.metrics.obstacles import Obstacle, from_markers
+
+    def marker(ns, kind, text, x, y, yaw, sx, sy, action=0):
+        q = NS(x=0.0, y=0.0, z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
+        return NS(ns=ns, action=action, type=kind, text=text, pose=NS(position=NS(x=x, y=y, z=0.25), orientation=q),
+                  scale=NS(x=sx, y=sy, z=0.5))
+
+    markers = [marker("", 0, "", 0, 0, 0, 0, 0, action=3), marker("obstacles", 1, "crate_1", 7.5, -7.5, 0.3, 0.8, 0.6),
+               marker("obstacles", 3, "post", 1.0, 2.0, 0.0, 0.6, 0.6),
+               marker("moving_obstacles", 3, "person_1", -8.0, -3.0, 0.0, 0.5, 0.5),
+               marker("robots", 3, "", 0.0, 0.0, 0.0, 0.3, 0.3), marker("robot_names", 9, "leader", 0, 0.35, 0, 0, 0)]
+    box, post = from_markers(markers)
+    assert box == Obstacle("crate_1", "box", 7.5, -7.5, pytest.approx(0.3), 0.8, 0.6, 0.0)
+    assert post == Obstacle("post", "cylinder", 1.0, 2.0, 0.0, 0.0, 0.0, 0.3)

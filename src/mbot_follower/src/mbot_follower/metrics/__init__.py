@@ -21,16 +21,18 @@ What the numbers mean (all times sim time unless marked wall):
                     a robot without a fresh pose.
   fit error         the same after the best rigid fit (rotation + translation) of the desired
                     shape onto the actual positions (shape.rigid_fit): the shape alone.
-  slot free         whether a follower's slot keeps slot_clearance to the walls of the map (1/0;
-                    NaN without a map): a slot in a wall (a column's slots behind a corner, a
-                    wide formation in a doorway) cannot be held, the follower drives the free
-                    path instead (the leader's trail).
+  slot free         whether a follower's slot keeps slot_clearance to the walls of the map and
+                    to the simulator's static obstacles, spawned ones from their spawn on (1/0;
+                    NaN without a map or obstacles): a slot in a wall or a box (a column's slots
+                    behind a corner, a wide formation in a doorway, a box in the way) cannot be
+                    held, the follower drives the free path instead (the leader's trail). The
+                    obstacles are `obstacle` and `obstacle_removed` events (shape, size, centre).
   steady slot RMS   the slot RMS restricted to NAVIGATING while the leader moves, and to ARRIVED;
                     while navigating, a follower's sample counts once its slot has been free
                     for free_hold (the time to get back from the trail). slot_blocked_share
-                    says how much of the navigating time the slots were in walls. A follower
-                    whose controller has gone silent for controller_silence (killed, before
-                    the coordinator declares it lost) does not count: that error is the loss
+                    says how much of the navigating time the slots were in walls or obstacles.
+                    A follower whose controller has gone silent for controller_silence (killed,
+                    before the coordinator declares it lost) does not count: that error is the loss
                     detection time, measured by the recovery figures.
   leader lateral    distance of the leader from the polyline of its global plan (the newest one not
                     later than the leader's pose; a new goal, FORMING, forgets the old plans); the

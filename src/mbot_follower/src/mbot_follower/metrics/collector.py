@@ -6,6 +6,7 @@ import numpy as np
 
 from mbot_common.geometry import Twist2D
 from mbot_follower.control_laws import energy_rate
+from mbot_follower.metrics import obstacles as static_obstacles
 from mbot_follower.metrics.records import NAN, ControllerSample, Event, MetricsConfig, RobotSample, Run, Sample
 from mbot_follower.shape import ShapeErrors, rigid_fit, shape_errors
 from mbot_follower.trail import Trail, slot_pose
@@ -55,6 +56,10 @@ class MetricsCollector(object):
         # (_trail_of), for the slots of a formation along the path.
         self._trail = Trail()
         self._trail_of = None
+        # The simulator's static obstacles (obstacles.Obstacle by name) and (t, tuple) of every
+        # change: a slot beside one is blocked as one beside a wall (on_obstacles).
+        self.obstacles = {}
+        self._obstacle_sets = []
 
     def _know(self, robot):
         if robot not in self.distance:
@@ -174,6 +179,23 @@ class MetricsCollector(object):
             self.energy[robot] += previous[1] * min(t - previous[0], self.config.stale_after)
         self.power[robot] = (t, power)
 
+    def on_obstacles(self, t, obstacles):
+        """The simulator's static obstacles at t (all of them, /stage/markers): a new or moved one
+        is an `obstacle` event (shape and size in detail, its centre), one gone `obstacle_removed`.
+        From t on a slot within slot_clearance of one is not free (the walls' rule)."""
+        now = {o.name: o for o in obstacles}
+        if now == self.obstacles:
+            return
+        for name in sorted(now):
+            o = now[name]
+            if self.obstacles.get(name) != o:
+                self.run.events.append(Event(t, "obstacle", name, static_obstacles.describe(o), o.x, o.y))
+        for name in sorted(set(self.obstacles) - set(now)):
+            o = self.obstacles[name]
+            self.run.events.append(Event(t, "obstacle_removed", name, static_obstacles.describe(o), o.x, o.y))
+        self.obstacles = now
+        self._obstacle_sets.append((t, tuple(now.values())))
+
     def on_contact(self, t, body_a, body_b, x, y):
         self.run.events.append(Event(t, "contact", body_a, body_b, x, y))
 
@@ -212,6 +234,8 @@ class MetricsCollector(object):
         a, entry_t = (entry[1], entry[0]) if entry is not None else (None, None)
         entry = self._in_force(self._statuses, t)
         state, lost = (entry[1], entry[2]) if entry is not None else ("", ())
+        entry = self._in_force(self._obstacle_sets, t)
+        obstacles = entry[1] if entry is not None else ()
         slot_error, fit_error, slot_free = {}, {}, {}
         errors = ShapeErrors(NAN, NAN, NAN, NAN, NAN, NAN)   # no follower measured
         lateral = NAN
@@ -232,8 +256,11 @@ class MetricsCollector(object):
                 for i, r in enumerate(followers, start=1):
                     slot_error[r] = math.hypot(actual[i][0] - desired[i][0], actual[i][1] - desired[i][1])
                     fit_error[r] = math.hypot(actual[i][0] - fitted[i][0], actual[i][1] - fitted[i][1])
-                    if self.free_space is not None:
-                        slot_free[r] = 1.0 if self.free_space.is_free(*desired[i]) else 0.0
+                    if self.free_space is not None or obstacles:
+                        free = (self.free_space is None or self.free_space.is_free(*desired[i])) and \
+                            not static_obstacles.blocks(obstacles, desired[i][0], desired[i][1],
+                                                        self.config.slot_clearance)
+                        slot_free[r] = 1.0 if free else 0.0
             # The plan in force when the leader was where its pose says: under load the 100 Hz
             # ground truth may lag behind the plans, and a plan that starts ahead of an old pose
             # is not the leader's lateral error.

@@ -161,7 +161,9 @@ def summarize(run):
 
     # Steady errors: ARRIVED, and NAVIGATING while the leader moves (its speed from this sample
     # and the one before) for the followers whose slots have been free for free_hold and whose
-    # controllers are alive.
+    # controllers are alive. A slot is blocked (slot_free 0) in or beside a wall of the map or a
+    # static obstacle of the simulator, spawned ones too (collector.on_obstacles): the follower
+    # cannot hold it and drives around.
     heard = {r: sorted(c.t for c in cs) for r, cs in controller.items()}
     navigating, arrived = [], []
     blocked_since = {}   # robot -> time of its slot's newest blocked sample
