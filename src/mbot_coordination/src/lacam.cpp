@@ -228,6 +228,11 @@ PlanResult LacamPlanner::solve(const Instance& inst, const PlannerOptions& optio
   Lacam lacam(inst, options.seed);
   PlanResult result = lacam.run(deadline);
   result.runtime_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (result.solved)
+  {
+    result.first_solution_s = result.runtime_s;
+    result.first_sum_of_costs = sumOfCosts(result.paths);
+  }
   return result;
 }
 

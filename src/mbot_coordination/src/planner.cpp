@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "mbot_coordination/lns.h"
 #include "mbot_coordination/sipp.h"
 
 namespace mbot_coordination
@@ -21,6 +22,18 @@ PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& option
     const std::string pp_message = result.message;
     result = LacamPlanner().solve(inst, rest);
     result.message = "pp: " + pp_message + (result.solved ? "" : "; lacam: " + result.message);
+  }
+  if (result.solved)
+  {
+    result.first_solution_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    result.first_sum_of_costs = sumOfCosts(result.paths);
+    const auto end = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(std::max(
+                              0.0, std::min(options.time_limit_s, result.first_solution_s + options.refine_s))));
+    if (options.refine_s > 0.0)
+    {
+      result.lns_iterations = refineLns(inst, result.paths, end, options.seed).iterations;
+      result.algorithm += "+lns";
+    }
   }
   result.runtime_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;

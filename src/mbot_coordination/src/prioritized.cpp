@@ -61,6 +61,11 @@ PlanResult PrioritizedPlanner::solve(const Instance& inst, const PlannerOptions&
     order.insert(order.begin(), failed);
   }
   result.runtime_s = elapsed();
+  if (result.solved)
+  {
+    result.first_solution_s = result.runtime_s;
+    result.first_sum_of_costs = sumOfCosts(result.paths);
+  }
   return result;
 }
 

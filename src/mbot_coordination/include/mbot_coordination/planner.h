@@ -1,7 +1,8 @@
 // One interface for the MAPF algorithms, picked by name (the live planner's parameter):
 //   "pp"     prioritized planning with SIPP per agent, re-prioritised restarts (fast, incomplete)
 //   "lacam"  LaCAM (complete: finds a solution when one exists, given the time)
-//   "auto"   pp for part of the time limit, then lacam on what pp could not solve
+//   "auto"   pp for part of the time limit, then lacam when pp could not solve it; then the
+//            solution is improved by large neighbourhood search for up to refine_s
 #pragma once
 
 #include <memory>
@@ -18,6 +19,8 @@ struct PlannerOptions
   unsigned seed = 0;
   // auto: the share of the time limit pp gets before lacam takes over
   double pp_share = 0.25;
+  // auto: time spent improving the first solution (LNS), within the time limit; 0: none
+  double refine_s = 0.5;
 };
 
 struct PlanResult
@@ -25,9 +28,12 @@ struct PlanResult
   bool solved = false;
   Paths paths;
   double runtime_s = 0.0;
-  std::string algorithm;  // which algorithm produced the paths (auto: pp or lacam)
-  std::string message;    // why it failed (time limit, no solution, ...)
-  long attempts = 0;      // pp: orders tried; lacam: high-level nodes generated
+  std::string algorithm;          // which algorithm produced the paths (auto: pp or lacam)
+  std::string message;            // why it failed (time limit, no solution, ...)
+  long attempts = 0;              // pp: orders tried; lacam: high-level nodes generated
+  double first_solution_s = 0.0;  // time to the first solution (auto: before the LNS)
+  long first_sum_of_costs = 0;    // its sum of costs
+  long lns_iterations = 0;
 };
 
 class Planner
@@ -58,7 +64,8 @@ public:
   std::string name() const override { return "lacam"; }
 };
 
-// pp for options.pp_share of the time limit, then lacam for the rest.
+// pp for options.pp_share of the time limit, then lacam for the rest; then LNS (lns.h) for up to
+// options.refine_s.
 class AutoPlanner : public Planner
 {
 public:
