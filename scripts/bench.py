@@ -22,6 +22,13 @@
                                       share, for a triangle driving 6 m in `field` and for the
                                       same robots with a move_base goal each
                                       (mbot_bringup/fleet_bench.py)
+    scripts/bench mapf [--json FILE] [--maps empty-32-32,...] [--time-limit S] [--max-agents K]
+                      [--algorithm auto|pp|lacam]
+                                      multi-agent path finding on the MovingAI instances
+                                      (mbot_coordination/bench/mapf), the EECBS protocol: each map,
+                                      scenarios 1..5, k = 10, 20, 30, ... agents until fewer than
+                                      half of the five are solved, 60 s per instance by default;
+                                      success, runtime p50 and sum of costs over the lower bound
     scripts/bench all [--json FILE]   sim and nav (the formation and fleet benchmarks take long: run them alone)
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
@@ -40,6 +47,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PLANNER_INPUTS = os.path.join(ROOT, "src", "mbot_navigation", "bench", "inputs")
 NAV_CONFIG = os.path.join(ROOT, "src", "mbot_navigation", "config")  # the shipped settings
 DESCRIPTION = os.path.join(ROOT, "src", "mbot_description")
+
+# The MAPF benchmark's inputs (MovingAI maps and scenarios; see its README).
+MAPF_INPUTS = os.path.join(ROOT, "src", "mbot_coordination", "bench", "mapf")
+MAPF_MAPS = ["empty-32-32", "random-32-32-10", "room-32-32-4", "maze-32-32-2", "warehouse-10-20-10-2-1"]
 
 # Simulator benchmark plan: robots -> (map, sim seconds). The 1000-robot run uses the same room
 # tiled 3x3 (60x60 m). Sim seconds are chosen so that each run takes tens of wall seconds.
@@ -185,6 +196,52 @@ def bench_fleet(sizes, modes):
                                    modes.split(","))
 
 
+def run_mapf(map_name, scen, agents, time_limit, algorithm):
+    """One mapf_bench instance on one core; its JSON (success false is a result, not an error)."""
+    cmd = [program("mbot_coordination", "mapf_bench"), "--map", os.path.join(MAPF_INPUTS, map_name + ".map"),
+           "--scen", os.path.join(MAPF_INPUTS, "%s-random-%d.scen" % (map_name, scen)), "--agents", str(agents),
+           "--time-limit", str(time_limit), "--algorithm", algorithm, "--json", "-"]
+    full = ["taskset", "-c", "0"] + cmd if shutil.which("taskset") else cmd
+    out = subprocess.run(full, stdout=subprocess.PIPE, universal_newlines=True)
+    if out.returncode not in (0, 1):  # 2: bad input, 3: an invalid solution (a planner bug)
+        sys.exit("mapf_bench failed (exit %d): %s" % (out.returncode, " ".join(cmd)))
+    return json.loads([line for line in out.stdout.splitlines() if line.startswith("{")][-1])
+
+
+def bench_mapf(maps, time_limit, max_agents, algorithm):
+    """The EECBS protocol: per map, k = 10, 20, ... on scenarios 1..5 until fewer than half are solved.
+    runtime_p50_s counts an unsolved run as the time limit; soc_ratio is the mean over solved runs of
+    sum of costs / lower bound (each agent's own 4-connected shortest path)."""
+    table = {}
+    runs = {}
+    for map_name in maps:
+        table[map_name] = {}
+        k = 10
+        while max_agents is None or k <= max_agents:
+            results = []
+            for scen in range(1, 6):
+                r = run_mapf(map_name, scen, k, time_limit, algorithm)
+                print("  %s k=%d scen %d: %s %.3f s" % (map_name, k, scen, "solved" if r["success"] else "failed",
+                                                        r["runtime_s"]), file=sys.stderr)
+                results.append(r)
+            solved = [r for r in results if r["success"]]
+            times = [r["runtime_s"] if r["success"] else time_limit for r in results]
+            row = {"solved": len(solved), "runs": len(results), "runtime_p50_s": round(median(times), 4)}
+            if solved:
+                row["soc_ratio"] = round(sum(r["sum_of_costs"] / r["lower_bound"] for r in solved) / len(solved), 4)
+                row["soc_ratio_max"] = round(max(r["sum_of_costs"] / r["lower_bound"] for r in solved), 4)
+                row["first_solution_p50_s"] = round(median([r["first_solution_s"] for r in solved]), 4)
+                row["first_soc_ratio"] = round(sum(r["first_sum_of_costs"] / r["lower_bound"] for r in solved)
+                                               / len(solved), 4)
+            table[map_name][str(k)] = row
+            runs["%s/%d" % (map_name, k)] = results
+            if 2 * len(solved) < len(results):
+                break
+            k += 10
+    return {"mapf": table, "mapf_settings": {"time_limit_s": time_limit, "algorithm": algorithm,
+                                             "max_agents": max_agents}, "mapf_runs": runs}
+
+
 def print_table(result):
     if "rtf" in result:
         print("\nSimulator (one core, as fast as possible, 360-beam 10 Hz lasers, 100 Hz physics)")
@@ -224,6 +281,20 @@ def print_table(result):
                 n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
                 f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
                 f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
+    if "mapf" in result:
+        st = result["mapf_settings"]
+        print("\nMAPF (MovingAI instances, scenarios 1-5, %s, %g s limit; ratio = sum of costs / sum of the"
+              " agents' own 4-connected shortest paths, mean over solved runs)" % (st["algorithm"], st["time_limit_s"]))
+        print("  %-24s %6s %8s %12s %14s %10s %10s" % (
+            "map", "agents", "solved", "runtime p50", "first sol. p50", "ratio", "first"))
+
+        def g(row, key, fmt):
+            return fmt % row[key] if key in row else "-"
+        for map_name, rows in result["mapf"].items():
+            for k, r in rows.items():
+                print("  %-24s %6s %8s %12s %14s %10s %10s" % (
+                    map_name, k, "%d/%d" % (r["solved"], r["runs"]), "%.3f s" % r["runtime_p50_s"],
+                    g(r, "first_solution_p50_s", "%.3f s"), g(r, "soc_ratio", "%.3f"), g(r, "first_soc_ratio", "%.3f")))
     if "trial" in result:
         t = result["trial"]
         print("\nNavigation trial (office, real_time_factor %g): %d of %d goals reached, %d contacts, "
@@ -239,7 +310,7 @@ def print_table(result):
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="scripts/bench", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=["sim", "nav", "formation", "fleet", "all"])
+    parser.add_argument("what", choices=["sim", "nav", "formation", "fleet", "mapf", "all"])
     parser.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     parser.add_argument("--trial-runs", type=int, default=100, help="navigation trial runs (0: skip)")
     parser.add_argument("--trial-rtf", type=float, default=0.0,
@@ -250,6 +321,10 @@ def main(argv=None):
     parser.add_argument("--seeds", type=int, default=10, help="formation: seeds per fleet size")
     parser.add_argument("--sizes", help="formation: fleet sizes (default 3,5,10); fleet: (default 3,10,20,40)")
     parser.add_argument("--modes", default="formation,navigation", help="fleet: formation, navigation or both")
+    parser.add_argument("--maps", default=",".join(MAPF_MAPS), help="mapf: map names (default: all five)")
+    parser.add_argument("--time-limit", type=float, default=60.0, help="mapf: seconds per instance (default 60)")
+    parser.add_argument("--max-agents", type=int, help="mapf: stop each map at this many agents")
+    parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp or lacam (default auto)")
     args = parser.parse_args(argv)
     if args.sim_runs < 1:
         parser.error("--sim-runs must be >= 1")
@@ -264,6 +339,16 @@ def main(argv=None):
         if not set(args.modes.split(",")) <= {"formation", "navigation"}:
             parser.error("--modes: formation, navigation or both (comma-separated)")
         result.update(bench_fleet(args.sizes or "3,10,20,40", args.modes))
+    if args.what == "mapf":
+        maps = args.maps.split(",")
+        unknown = [m for m in maps if not os.path.exists(os.path.join(MAPF_INPUTS, m + ".map"))]
+        if unknown:
+            parser.error("--maps: no such map %s (known: %s)" % (", ".join(unknown), ", ".join(MAPF_MAPS)))
+        if args.time_limit <= 0:
+            parser.error("--time-limit must be > 0")
+        if args.max_agents is not None and args.max_agents < 10:
+            parser.error("--max-agents must be >= 10")
+        result.update(bench_mapf(maps, args.time_limit, args.max_agents, args.algorithm))
     result["machine"] = machine()
     print_table(result)
     if args.json:
