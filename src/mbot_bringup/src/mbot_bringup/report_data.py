@@ -12,8 +12,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from mbot_follower.trail import Trail, slot_pose
-from mbot_follower.metrics import _holds_under  # the recovery rule, used for switches too
+from mbot_follower.trail import LeaderTrail, slot_pose, trail_start
+from mbot_follower.metrics import _holds_under  # the recovery rule: the switch's settling figure
 
 
 class ReportError(ValueError):
@@ -283,19 +283,18 @@ def slot_positions(assignment, leader_pose, trail=None):
 
 
 def leader_trail(series, assignment, i):
-    """The Trail of the assignment's leader from the first sample at or after the assignment up
-    to sample i: the path its slots lie on when it is along the path (None without a pose)."""
-    trail = None
-    for j in range(i + 1):
-        if series.t[j] + series.t0 < assignment.t - 1e-9:
-            continue
-        pose = series.pose(assignment.leader, j)
-        if pose is None:
-            continue
-        if trail is None:
-            trail = Trail()
-            trail.start(*pose)
-        trail.add(pose[0], pose[1])
+    """The leader's path (trail.LeaderTrail) of the assignment up to sample i, from the samples:
+    the path its slots lie on when it is along the path (None without a pose)."""
+    poses = [(series.t[j] + series.t0,) + series.pose(assignment.leader, j) for j in range(i + 1)
+             if series.pose(assignment.leader, j) is not None]
+    start = trail_start(poses, assignment.t)
+    if start is None:
+        return None
+    trail = LeaderTrail()
+    trail.restart(assignment.t, start[1:4])
+    for p in poses:
+        if p[0] > start[0] + 1e-9:
+            trail.follow(*p[1:4])
     return trail
 
 
@@ -373,7 +372,9 @@ def fleet_path_length(series):
 def switch_settling(run):
     """One dict per formation switch: t_s (sim), formation, previous, settle_s (time until the
     slot RMS is under the recovery bound and stays there for the recovery hold, as for a loss;
-    None: never) and peak_rms_m (largest slot RMS from the switch until it settled)."""
+    None: never) and peak_rms_m (largest slot RMS from the switch until it settled). Settling is
+    its own figure, later than the switch time (switch_done_times: the metrics' one rule of when
+    a switch is done)."""
     config = run.config
     out = []
     for e in sorted_events(run):

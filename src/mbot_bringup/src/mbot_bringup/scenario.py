@@ -25,14 +25,16 @@ import os
 from mbot_common.strict_yaml import ConfigError, Reader, load_yaml
 from mbot_common.world import FAULT_KEYS, Faults, check_faults, check_name
 from mbot_bringup.fleet_world import MAX_ROBOTS
+from mbot_follower.metrics.settle import switch_done_times
 
 MODES = ("formation", "dispatch")
 LOCALIZATIONS = ("fake", "pf")
 TOPOLOGIES = ("star", "chain")
 
 #: Events a step can wait for (`after:`) and a run can end on (`end:`). The fleet states are the
-#: coordinator's (/fleet/status) when they begin; `formed`: every follower within
-#: TimelineConfig.formed_tolerance of its slot of the current formation; `goals_done`: every
+#: coordinator's (/fleet/status) when they begin; `formed`: the current formation stands, by the
+#: metrics' switch rule (mbot_follower.metrics.settle: every follower within 0.3 m of its slot
+#: for 0.5 s, from ground truth); `goals_done`: every
 #: dispatched move_base goal has finished (dispatch mode).
 EVENTS = ("forming", "navigating", "arrived", "degraded", "aborted", "paused", "formed", "goals_done")
 
@@ -102,9 +104,7 @@ DISPATCH_DEFAULTS = {"finished": True, "failed_steps": 0, "contacts": 0}
 class TimelineConfig(object):
     """How the runner judges events that no node announces."""
 
-    def __init__(self, formed_tolerance=0.3, formed_hold=0.5, settle=2.0):
-        self.formed_tolerance = formed_tolerance  # every follower this close to its slot: formed [m]
-        self.formed_hold = formed_hold            # ... for this long [s sim]
+    def __init__(self, settle=2.0):
         self.settle = settle                      # after the end event, run on this long [s sim]
 
 
@@ -539,27 +539,6 @@ def scenario_window(run, start, end):
     return out
 
 
-def switch_times(run, tolerance=0.3, hold=0.5):
-    """One dict per formation switch of a metrics Run (mbot_follower.metrics): formation, t_s and
-    switch_time_s, the time until every follower was within `tolerance` [m] of its new slot for
-    `hold` [s] (None: never)."""
-    out = []
-    for switch in (e for e in run.events if e.kind == "switch"):
-        samples = [s for s in run.samples if s.t >= switch.t]
-        reached = None
-        since = None
-        for s in samples:
-            if s.slot_max < tolerance:   # NaN (no follower measured) is not within
-                since = s.t if since is None else since
-                if s.t - since >= hold - 1e-9:
-                    reached = since - switch.t
-                    break
-            else:
-                since = None
-        out.append({"formation": switch.name, "t_s": switch.t, "switch_time_s": reached})
-    return out
-
-
 def _largest(values):
     """max of the values; None when there are none or one is None (that one never happened)."""
     if not values or any(v is None for v in values):
@@ -589,7 +568,7 @@ def measure(name, summary, run, facts):
     if name == "duration_s":
         return summary["duration_s"]
     if name == "max_switch_time_s":
-        times = switch_times(run)
+        times = switch_done_times(run)   # the metrics' one rule (mbot_follower.metrics.settle)
         return _largest([s["switch_time_s"] for s in times]) if times else None
     if name == "max_time_to_degraded_s":
         return _largest([r["time_to_degraded_s"] for r in summary["recoveries"]]) if summary["recoveries"] else None

@@ -11,6 +11,7 @@ import time
 from mbot_bringup.console import say
 from mbot_bringup.fleet_launch import WALL_PER_SIM, start_wall
 from mbot_bringup.scenario import Timeline, TimelineConfig, loss_detection_times
+from mbot_follower.metrics.settle import SwitchSettle
 
 STATUS_PERIOD = 10.0       # [s wall] a new status line when the output is not a terminal
 STATE_EVENTS = {"FORMING": "forming", "NAVIGATING": "navigating", "ARRIVED": "arrived", "DEGRADED": "degraded",
@@ -27,7 +28,8 @@ def round_ended(results, round_goals):
 class ScenarioPlayer(object):
     """Plays a scenario's timeline on a running fleet (rospy is initialised by the caller) and
     returns what happened. Events come from /fleet/status (state changes, pauses), from the
-    ground truth (formed) and from the robots' move_base results (goals_done)."""
+    ground truth (formed: the metrics' switch rule, SwitchSettle) and from the robots' move_base
+    results (goals_done)."""
 
     def __init__(self, scenario, robots, run_dir, screenshots=None, config=None, show_status=True):
         import rospy
@@ -65,7 +67,7 @@ class ScenarioPlayer(object):
         self.round_size = None     # goals of the newest dispatch step (their ids: round_goals)
         self.pending_shots = []    # (t, name)
         self.awaiting_formation = None
-        self.formed_since = None
+        self.settle = SwitchSettle()   # the current formation stands (`formed`)
         self.formed = False
         self.paused = False
         self.states_seen = 0
@@ -146,12 +148,10 @@ class ScenarioPlayer(object):
                                               or assignment.formation == self.awaiting_formation)
         if current and self.awaiting_formation is not None:
             self.awaiting_formation = None
-        within = current and bool(errors) and max(errors.values()) < self.config.formed_tolerance
-        if not within:
-            self.formed_since, self.formed = None, False
-        elif self.formed_since is None:
-            self.formed_since = t
-        if within and not self.formed and t - self.formed_since >= self.config.formed_hold:
+        if not (current and errors and self.settle.within(errors)):
+            self.settle.reset()   # formed again only after the rule held again
+            self.formed = False
+        elif self.settle.update(t, errors) and not self.formed:
             self.formed = True
             self.timeline.observe("formed", t)
 
@@ -208,7 +208,8 @@ class ScenarioPlayer(object):
             answer = self._service("/fleet/set_formation", SetFormation)(formation=a["name"], spacing=a["spacing"])
             if answer.success:
                 self.awaiting_formation = a["name"]
-                self.formed, self.formed_since = False, None
+                self.formed = False
+                self.settle.reset()
                 self._shot_later(t + 3.0, "switch_%s" % a["name"])
             return answer.success, answer.message
         if step.action == "kill_controller":

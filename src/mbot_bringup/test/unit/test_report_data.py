@@ -214,8 +214,12 @@ def test_a_column_along_the_path_has_its_slots_on_the_leaders_path():
     series = Series(c.run)
     i = len(series.t) - 1                 # t = 2.9 s: a at (1.5, 0.4), b at (0.9, 0) before the corner
     leader = series.pose("L", i)
-    on_path = slot_positions(a, leader, leader_trail(series, a, i))
+    trail = leader_trail(series, a, i)
+    on_path = slot_positions(a, leader, trail)
     for r in ("a", "b"):
         assert on_path[r] == pytest.approx(series.pose(r, i)[:2], abs=1e-9)
+    # the one definition (trail.LeaderTrail): the collector's path of the same samples, alike
+    assert (trail.since, trail.length()) == (c._trail.since, pytest.approx(c._trail.length(), abs=1e-9))
+    assert trail.point_behind(trail.length()) == c._trail.point_behind(c._trail.length()) == (0.0, 0.0)
     rigid = slot_positions(a, leader)      # no trail: rigid slots, b's 0.85 m off
     assert math.hypot(rigid["b"][0] - 0.9, rigid["b"][1]) == pytest.approx(math.hypot(0.6, 0.6))

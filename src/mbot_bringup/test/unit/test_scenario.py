@@ -7,10 +7,9 @@ import pytest
 
 from mbot_bringup.scenario import (CRITERIA, FORMATION_DEFAULTS, LAB_THRESHOLDS, Timeline, TimelineConfig, check,
                                    check_against_world, criteria_reasons,
-                                   evaluate, load_scenario, loss_detection_times, scenario_window, summary_lines,
-                                   switch_times)
+                                   evaluate, load_scenario, loss_detection_times, scenario_window, summary_lines)
 from mbot_common.strict_yaml import ConfigError
-from mbot_follower.metrics import Event, Run, Sample
+from mbot_follower.metrics import Event, RobotSample, Run, Sample, switch_done_times
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FIXTURES = os.path.join(HERE, "..", "fixtures", "scenarios")
@@ -174,19 +173,20 @@ def run_with_switch():
     run = Run()
     errors = {10.0: 1.2, 11.0: 0.9, 12.0: 0.25, 12.1: 0.35, 13.0: 0.5, 14.0: 0.29, 14.2: 0.2, 14.4: 0.1,
               14.6: 0.1, 15.0: 0.1}
-    run.samples = [sample(t, e) for t, e in sorted(errors.items())]
+    nan = float("nan")
+    run.samples = [sample(t, e)._replace(robots={"f1": RobotSample(nan, nan, nan, e, nan, 0.0, 0.0)})
+                   for t, e in sorted(errors.items())]
     run.events = [Event(10.0, "switch", "line", "triangle", float("nan"), float("nan"))]
     return run
 
 
-def test_switch_time_is_until_the_new_shape_holds():
-    times = switch_times(run_with_switch(), tolerance=0.3, hold=0.5)
-    assert len(times) == 1
-    assert times[0]["formation"] == "line"
-    assert times[0]["switch_time_s"] == pytest.approx(4.0)
+def test_the_switch_time_criterion_is_the_metrics_switch_rule():
+    run = run_with_switch()
+    value = evaluate({"max_switch_time_s": 6.0}, summary_of(), run, FACTS)[0]["value"]
+    assert value == pytest.approx(4.0) == switch_done_times(run)[0]["switch_time_s"]
     never = run_with_switch()
-    never.samples = [s._replace(slot_max=0.5) for s in never.samples]
-    assert switch_times(never)[0]["switch_time_s"] is None
+    never.samples = [s._replace(robots={"f1": s.robots["f1"]._replace(slot_error=0.5)}) for s in never.samples]
+    assert evaluate({"max_switch_time_s": 6.0}, summary_of(), never, FACTS)[0]["value"] is None
 
 
 def summary_of(**fleet):

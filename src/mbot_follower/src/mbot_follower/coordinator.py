@@ -35,7 +35,14 @@ slot, trail, safety_stop and give_way while robots pass each other, and an excus
 the leader drive on every time it flickered (the corridor column formed past the entrance). So
 the first regroup after a switch waits for every follower, excused or not, until all are within
 ``resume_error`` or ``regroup_timeout`` passes; held followers give way meanwhile (GiveWay), so
-they do not jam for good. The switch is over when its shape is stable or that regroup ended.
+they do not jam for good.
+
+A switch is done by the one rule of the metrics (mbot_follower.metrics.settle.SwitchSettle):
+every follower whose slot is not blocked within 0.3 m of its new slot for 0.5 s. The event
+"switched" says when the shape was reached, and `switching` (on /fleet/status) goes off when the
+rule has held, so the metrics record the coordinator's own done time. FORMING and ARRIVED wait
+for more, a stable formation (``form_edge_tolerance``, ``form_heading_tolerance`` for
+``stable_time``): a follower that drove backwards into its slot has turned round.
 
 Where the map is free ahead of the leader (``switch_room_ahead`` metres, a spacing to either
 side), the leader drives on through a switch and waits only for followers that lag behind their
@@ -71,9 +78,9 @@ new slot, the middle one, is 0.53 m beside that held neighbour), and only the le
 frees them all (benchmark seeds 2 and 8 waited 8 and 19 s before).
 
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
-coordinator records the leader's path from the poses of every update(), started anew with each
-assignment, and measures the followers against those slots and their headings, so a column
-bent around a corner is formed.
+coordinator records the leader's path (trail.LeaderTrail, as the metrics do) from the poses of
+every update(), started anew with each assignment, and measures the followers against those
+slots and their headings, so a column bent around a corner is formed.
 
 A goal that cannot be reached as given (a NaN, off the map, in a wall) or an unknown formation
 is refused at once: the state does not change and the message says why.
@@ -92,8 +99,9 @@ from mbot_common.geometry import normalize_angle, relative, transform_point
 from mbot_follower.assignment import assign_single_file, assign_slots
 from mbot_follower.fleet_io import Assignment
 from mbot_follower.formations import FormationError, FormationLibrary
+from mbot_follower.metrics.settle import SwitchSettle
 from mbot_follower.shape import shape_errors
-from mbot_follower.trail import Trail, slot_pose
+from mbot_follower.trail import LeaderTrail, slot_pose
 
 IDLE, FORMING, NAVIGATING, ARRIVED, DEGRADED, ABORTED = (
     "IDLE", "FORMING", "NAVIGATING", "ARRIVED", "DEGRADED", "ABORTED")
@@ -107,9 +115,10 @@ class CoordinatorConfig(object):
     """Thresholds and times of the coordinator (sim time)."""
 
     def __init__(self):
-        self.form_edge_tolerance = 0.3             # FORMING ends below this edge-length error [m]
+        # a stable formation (FORMING ends, ARRIVED; a switch is done by metrics.settle's rule):
+        self.form_edge_tolerance = 0.3             # below this edge-length error [m]
         self.form_heading_tolerance = math.radians(5.0)  # ... and this follower heading error [rad]
-        self.stable_time = 0.5                     # the shape must hold this long [s]
+        self.stable_time = 0.5                     # ... for this long [s]
         self.forming_timeout = 60.0                # then navigate anyway, saying who is off [s]
         self.arrive_timeout = 30.0                 # leader at goal: ARRIVED after this at the latest [s]
         self.loss_timeout = 1.0                    # unheard this long = lost [s]
@@ -175,6 +184,7 @@ class FleetCoordinator(object):
         self._pause_until = None
         self._no_pause_before = -1e9
         self._switch_started = None
+        self._switch_settle = SwitchSettle()  # when the switch under way is done
         self._switch_waits = False           # after a switch: the leader waits for every follower
         self._switch_drives = False          # ... but only for those behind their slots (room ahead)
         self._switch_fast = False            # ... at switch_leader_vel (every follower ahead of its slot)
@@ -185,7 +195,7 @@ class FleetCoordinator(object):
         self._regroup_ended = (-1e9, None)   # (when the last regroup ended, when it had begun)
         self._excused_since = {}             # follower -> since when it is excused (regrouping)
         self._no_regroup_before = -1e9
-        self._trail = Trail()                # the leader's path since the assignment (path slots)
+        self._trail = LeaderTrail()          # the leader's path since the assignment (path slots)
 
     # --- what the outside sees ----------------------------------------------------------------
 
@@ -283,7 +293,7 @@ class FleetCoordinator(object):
             actions += self._reassign(poses, now)
         if self.assignment is not None and self.assignment.leader in poses:
             leader = poses[self.assignment.leader]
-            self._trail.add(leader.x, leader.y)
+            self._trail.follow(leader.x, leader.y, leader.theta)
         blocked_now = self.blocked_followers(poses)
         for r, why in blocked_now.items():
             # a wall's slot counts again free_hold after it is clear; a lost robot's at once (module docstring)
@@ -292,8 +302,9 @@ class FleetCoordinator(object):
         self.blocked = sorted(r for r, until in self._blocked_until.items() if r in blocked_now or now < until)
         self.errors = self._shape_errors(poses)
         stable = self._stable(now)
-        if self._switch_started is not None and stable:
-            self.events.append((now, "switched", "%s reached in %.1f s" % (self.formation, now - self._switch_started)))
+        if self._switch_started is not None and self._switch_done(now, poses):
+            self.events.append((now, "switched", "%s reached in %.1f s" % (
+                self.formation, self._switch_settle.reached_at - self._switch_started)))
             self._switch_started = None
             self._switch_waits = self._switch_drives = False
 
@@ -511,7 +522,8 @@ class FleetCoordinator(object):
         leader_pose = poses[self.leader]
         self._blocked_until, self._blocked_by = {}, {}
         # the leader's path starts here: path slots are the rigid slots at first
-        self._trail.start(leader_pose.x, leader_pose.y, leader_pose.theta)
+        self._trail.restart(now, (leader_pose.x, leader_pose.y, leader_pose.theta))
+        self._switch_settle.reset()   # new slots: a switch under way is measured against them
         if len(self.members) == 1:  # the leader alone: no shape to keep
             self.assignment = Assignment(self.leader, self.formation, self.spacing, {self.leader: (0.0, 0.0)},
                                          {self.leader: ""})
@@ -564,6 +576,14 @@ class FleetCoordinator(object):
         if self._stable_since is None:
             self._stable_since = now
         return now - self._stable_since >= self.config.stable_time
+
+    def _switch_done(self, now, poses):
+        """The switch under way is done (metrics.settle's rule on the slot errors now)."""
+        if self.assignment is None or self.assignment.leader not in poses:
+            self._switch_settle.since = None   # nothing to measure is not within
+            return False
+        errors = {r: e for r, (e, _) in self.slot_errors(poses).items() if r in self.members}
+        return self._switch_settle.update(now, errors, self.blocked)
 
     def slot_poses(self, poses):
         """{robot: Pose2D in the map} of every slot of the assignment, the leader's included: where

@@ -4,7 +4,9 @@ the controllers' modes, sends targets and switches on the public topics, and wai
 conditions in sim time (with a wall-clock bound, since at real_time_factor 0 sim time may race or
 stall). What it measures comes from the simulator, not from what the coordinator says of itself.
 The slots of a formation along the path (a column) are placed on the leader's ground-truth path
-since the assignment (trail.path_slot), like the coordinator and the metrics place them.
+since the assignment (trail.LeaderTrail, trail.path_slot), like the coordinator and the metrics
+place them. Whether a switch is done is the metrics' rule (metrics.settle.SwitchSettle) on the
+probe's samples: `switch_done`.
 """
 import collections
 import math
@@ -18,9 +20,11 @@ from nav_msgs.msg import Odometry
 from std_msgs.msg import Header, String
 
 from mbot_common.geometry import Pose2D, yaw_of
+from mbot_follower.metrics.settle import SwitchSettle
 from mbot_follower.metrics_node import stamp_of
-from mbot_follower.trail import Trail, slot_pose
+from mbot_follower.trail import LeaderTrail, slot_pose, trail_start
 
+STATES_WITH_SLOTS = ("FORMING", "NAVIGATING", "ARRIVED", "DEGRADED")
 WALL_LIMIT = 600.0  # [s wall] no wait lasts longer than this, whatever sim time does
 HISTORY = 50        # ground truth messages kept per robot (1 s at 50 Hz) to align the samples
 SILENT_AFTER = 0.5  # [s sim] a robot whose ground truth is this far behind the newest is gone
@@ -72,8 +76,7 @@ class FleetProbe(object):
         self.status = None
         self.states = []       # (t, state, reason): t the status message's stamp [s sim]
         self.assignment = None
-        self.trail = Trail()   # the leader's ground truth since the assignment (path slots)
-        self._trail_pending = False
+        self.trail = LeaderTrail()   # the leader's ground truth since the assignment (path slots)
         self.contacts = []
         self._truth_subs = {r: self._subscribe_truth(r) for r in robots}
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=50)
@@ -105,11 +108,9 @@ class FleetProbe(object):
             pose = Pose2D(p.position.x, p.position.y, yaw_of(p.orientation))
             self.truth[robot] = (msg.header.stamp.to_sec(), pose, math.hypot(v.x, v.y))
             self._history[robot].append(self.truth[robot])
-            if self.assignment is not None and robot == self.assignment.leader:
-                if self._trail_pending:
-                    self.trail.start(pose.x, pose.y, pose.theta)
-                    self._trail_pending = False
-                self.trail.add(pose.x, pose.y)
+            if self.assignment is not None and robot == self.assignment.leader \
+                    and self.truth[robot][0] > self.trail.since + 1e-9:
+                self.trail.follow(pose.x, pose.y, pose.theta)
 
     def _on_status(self, msg):
         with self.lock:
@@ -121,7 +122,15 @@ class FleetProbe(object):
     def _on_assignment(self, msg):
         with self.lock:
             self.assignment = msg
-            self._trail_pending = True   # the path starts at the leader's next pose
+            # the leader's path starts at its pose at the assignment's stamp; this callback may
+            # run late, after the leader's next poses: those are on the path already
+            since = stamp_of(msg.header)
+            history = self._history.get(msg.leader, ())
+            start = trail_start(history, since)
+            self.trail.restart(since, start[1][:3] if start is not None and start[0] <= since + 1e-9 else None)
+            for t, pose, _ in history:
+                if t > since + 1e-9:
+                    self.trail.follow(pose.x, pose.y, pose.theta)
 
     def _on_contact(self, msg):
         with self.lock:
@@ -148,7 +157,7 @@ class FleetProbe(object):
         a path slot on the leader's path as recorded now."""
         if assignment is None or assignment.leader not in poses:
             return {}
-        trail = self.trail if assignment.along_path and not self._trail_pending and len(self.trail) else None
+        trail = self.trail if assignment.along_path else None
         return {s.robot: slot_pose(poses[assignment.leader], (s.offset.x, s.offset.y), trail)
                 for s in assignment.slots}
 
@@ -172,6 +181,44 @@ class FleetProbe(object):
                 continue
             errors[s.robot] = math.hypot(poses[s.robot].x - slots[s.robot].x, poses[s.robot].y - slots[s.robot].y)
         return errors
+
+    def _settle(self, settle, samples, formation, since):
+        """Feed the samples (of self.samples) from `since` [s sim] to `settle` (SwitchSettle):
+        each one's slot errors if its assignment is `formation`; True once it is done."""
+        for (t, state, poses, _, a) in samples:
+            if t < since or state not in STATES_WITH_SLOTS:
+                continue
+            if a is None or a.formation != formation or a.leader not in poses:
+                settle.since = None
+            elif settle.update(t, self.slot_errors(poses, a)):
+                return True
+        return settle.done
+
+    def switch_done(self, formation, since):
+        """The metrics' rule (SwitchSettle: every follower within 0.3 m of its slot for 0.5 s) on
+        this probe's samples from `since` [s sim] with `formation` assigned: (reached_at, done_at)
+        [s sim], None while not done. The probe does not know which slots the coordinator counts
+        as blocked: every follower counts."""
+        settle = SwitchSettle()
+        with self.lock:
+            samples = list(self.samples)
+        return (settle.reached_at, settle.done_at) if self._settle(settle, samples, formation, since) else None
+
+    def wait_switch_done(self, formation, since, sim_timeout):
+        """Wait until the switch to `formation` made at `since` [s sim] is done (switch_done);
+        returns (reached_at, done_at) [s sim]."""
+        settle = SwitchSettle()
+        seen = [0]
+
+        def done():
+            with self.lock:
+                samples = self.samples[seen[0]:]
+                seen[0] = len(self.samples)
+            return self._settle(settle, samples, formation, since)
+
+        self.wait(done, sim_timeout, "the %s to stand (every follower within %.2f m of its slot for %.1f s)"
+                  % (formation, settle.tolerance, settle.hold))
+        return settle.reached_at, settle.done_at
 
     def last_heard(self, robot, sim_timeout=30.0):
         """The stamp of the last state that `robot`'s dead controller sent [s sim], once all of

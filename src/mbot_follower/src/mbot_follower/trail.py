@@ -13,6 +13,12 @@ drove, also around corners. Behind the trail's oldest point the path goes on str
 tail heading (the leader's heading when the trail was started): right after `start()` every path
 slot is exactly the rigid slot.
 
+The leader's path of an assignment (`LeaderTrail`, one definition for the coordinator, the metrics
+collector, the fleet probe and the report): it starts at the leader's pose at the assignment's
+time (the newest pose not later than it; without one, the first pose after it), then takes every
+later pose of the leader, points at least LEADER_TRAIL_STEP apart, the newest LEADER_TRAIL_LENGTH
+metres of it.
+
 Points are in the world (map) frame [m]. Pure Python.
 """
 import collections
@@ -24,6 +30,10 @@ from mbot_common.geometry import Pose2D, compose
 #: behind it to as much ahead of it: single trail steps (min_step apart) of a noisy pose would
 #: turn the direction by degrees.
 HEADING_HALF_WINDOW = 0.15
+#: [m] the leader's path keeps points this far apart ...
+LEADER_TRAIL_STEP = 0.05
+#: [m] ... and this much of the newest path (a column of 40 robots at 1.2 m is 47 m long)
+LEADER_TRAIL_LENGTH = 50.0
 
 
 class Trail(object):
@@ -139,6 +149,42 @@ class Trail(object):
             arc += step
         target = max(0.0, min(at + lookahead, self._length - distance))
         return self.point_behind(self._length - target)
+
+
+class LeaderTrail(Trail):
+    """The leader's path since an assignment (module docstring): restart() at each assignment,
+    then follow() with each later pose of the leader, in time order. Empty until it has a pose:
+    path slots are then the rigid ones (slot_pose)."""
+
+    def __init__(self):
+        Trail.__init__(self, LEADER_TRAIL_STEP, LEADER_TRAIL_LENGTH)
+        self.since = None   # the assignment's time [s]
+
+    def restart(self, since, pose=None):
+        """A new assignment made at `since` [s]; `pose` (x, y, theta): the leader's newest pose not
+        later than `since`, None if there is none (the path then starts at the next follow())."""
+        self.clear()
+        self.since = since
+        if pose is not None:
+            self.start(*pose[:3])
+
+    def follow(self, x, y, theta):
+        """The leader's next pose after the assignment."""
+        if len(self):
+            self.add(x, y)
+        else:
+            self.start(x, y, theta)
+
+
+def trail_start(poses, since):
+    """Where the leader's path of an assignment made at `since` [s] starts: of `poses`, (t, x, y,
+    theta, ...) in time order, the newest not later than `since`, else the first; None if empty."""
+    start = None
+    for p in poses:
+        if p[0] > since + 1e-9:
+            return start if start is not None else p
+        start = p
+    return start
 
 
 # ------------------------------------------------------------------ path slots

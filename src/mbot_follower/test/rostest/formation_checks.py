@@ -9,7 +9,9 @@ The check is chosen by the private parameter ~check (one .test file per check):
               ~omni: the followers are omni robots and must drive sideways too)
   obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
   switch    - switch to `line` while moving: the line is reached; then to `column`: the leader
-              drives faster until the column is there, then at its usual speed again
+              drives faster until the column is there, then at its usual speed again (a switch
+              is done by the metrics' rule, FleetProbe.wait_switch_done: every follower within
+              0.3 m of its slot for 0.5 s, from ground truth)
   loss      - follower_1's controller is killed: DEGRADED within 1 s of the loss, the others ARRIVE
   limit     - max_linear_vel 0.3 on follower_1: its speed stays <= 0.3 m/s while the leader's does not
   corridor  - 4 robots diamond -> column -> diamond through the corridor, no contact
@@ -35,6 +37,7 @@ from geometry_msgs.msg import Pose2D as Pose2DMsg
 from std_msgs.msg import String
 
 from mbot_follower.fleet_probe import FleetProbe
+from mbot_follower.metrics.settle import SWITCH_TOLERANCE
 
 
 def robots_param():
@@ -156,24 +159,19 @@ class FormationChecks(unittest.TestCase):
         p.wait(lambda: p.assignment.formation == "line", 5.0, "the line assignment")
         slots = [s for s in p.assignment.slots if s.robot != p.assignment.leader]
         self.assertTrue(all(abs(s.offset.x) < 1e-6 for s in slots), "line slots are beside the leader")
-
-        def in_slots():
-            errors = p.slot_errors({r: v[1] for r, v in p.truth.items()}, p.assignment)
-            return errors and max(errors.values()) < 0.3
-
-        t_reached = p.wait(in_slots, 60.0, "the followers on their line slots")
+        t_reached, t_done = p.wait_switch_done("line", t_switch, 60.0)
         rospy.loginfo("switch: line reached %.1f s after the switch", t_reached - t_switch)
         # the followers were behind the line's slots: the leader kept its usual speed
         usual = rospy.get_param("/%s/move_base/DWAPlannerROS/max_vel_x" % p.status.leader)
-        self.assertLess(self.leader_top_speed(t_switch, t_reached), usual + 0.02)
+        self.assertLess(self.leader_top_speed(t_switch, t_done), usual + 0.02)
 
         # line -> column: both followers are ahead of their new slots, so the leader drives
         # faster (~switch_leader_vel) until the column is there, then as before
         t_switch = rospy.get_time()
         p.formation_pub.publish(String("column"))
         p.wait(lambda: p.assignment.formation == "column", 5.0, "the column assignment")
-        t_reached = p.wait(in_slots, 60.0, "the followers on their column slots")
-        top = self.leader_top_speed(t_switch, t_reached)
+        t_reached, t_done = p.wait_switch_done("column", t_switch, 60.0)
+        top = self.leader_top_speed(t_switch, t_done)
         rospy.loginfo("switch: column reached %.1f s after the switch, the leader at up to %.2f m/s",
                       t_reached - t_switch, top)
         self.assertGreater(top, usual + 0.05)
@@ -275,32 +273,32 @@ class FormationChecks(unittest.TestCase):
         client.send_goal(FleetGoalGoal(target=Pose2DMsg(13.0, 0.0, 0.0), formation="diamond", spacing=1.2))
         p.wait(lambda: p.state() == "NAVIGATING", 120.0, "NAVIGATING in a diamond")
         self.assertEqual(p.assignment.formation, "diamond")
+        t_switch = rospy.get_time()
         answer = switch(formation="column", spacing=0.0)
         self.assertTrue(answer.success, answer.message)
         p.wait(lambda: p.assignment.formation == "column", 5.0, "the column assignment")
-        p.wait(lambda: self.formed(0.3, trace=True), 60.0, "the column formed")
-        self.assertLess(p.truth[p.status.leader][1].x, -9.8, "the column must form before the corridor:\n%s\n%s" % (
+        t_reached, _ = p.wait_switch_done("column", t_switch, 60.0)
+        rospy.loginfo("corridor: the column stood %.1f s after the switch", t_reached - t_switch)
+        leader_x = next(poses[a.leader].x for (t, _, poses, _, a) in p.samples_in(("NAVIGATING", "FORMING"), t_reached))
+        self.assertLess(leader_x, -9.8, "the column must form before the corridor:\n%s\n%s" % (
             p.describe(), "\n".join("t=%.1f %s (%s)" % s for s in p.states[-10:])))
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 300.0, "ARRIVED through the corridor")
         self.assertEqual(p.state(), "ARRIVED", p.status.reason)
         self.assertTrue(client.wait_for_result(rospy.Duration(10.0)))
         result = client.get_result()
         self.assertTrue(result.success, result.message)
+        t_switch = rospy.get_time()
         answer = switch(formation="diamond", spacing=0.0)
         self.assertTrue(answer.success, answer.message)
         p.wait(lambda: p.assignment.formation == "diamond", 5.0, "the diamond assignment")
-        p.wait(lambda: self.formed(0.3), 90.0, "the diamond formed again after the corridor")
+        p.wait_switch_done("diamond", t_switch, 90.0)
         self.leader_at(13.0, 0.0)
         self.assertNoContacts()
 
-    def formed(self, tolerance, trace=False):
-        """Every follower within `tolerance` of its slot (ground truth). `trace`: log where each
-        robot is, its slot error and its controller's mode (a failure shows who held up whom)."""
+    def formed(self):
+        """Every follower within the switch tolerance of its slot now (ground truth)."""
         errors = self.probe.slot_errors({r: v[1] for r, v in self.probe.truth.items()}, self.probe.assignment)
-        if trace:
-            rospy.loginfo_throttle(0.3, "formed? %s | %s" % (self.probe.status.reason,
-                                                             self.probe.describe().replace("\n", " |")))
-        return bool(errors) and max(errors.values()) < tolerance
+        return bool(errors) and max(errors.values()) < SWITCH_TOLERANCE
 
     def run_leader_loss(self):
         from mbot_msgs.srv import RemoveRobot
@@ -322,7 +320,7 @@ class FormationChecks(unittest.TestCase):
         p.wait(lambda: p.state() in ("ARRIVED", "ABORTED"), 240.0, "ARRIVED under the new leader")
         self.assertEqual(p.state(), "ARRIVED", p.status.reason)
         self.leader_at(5.0, 0.0)
-        self.assertTrue(self.formed(0.3), "the two left are not in formation")
+        self.assertTrue(self.formed(), "the two left are not in formation:\n%s" % p.describe())
         self.assertNoContacts()
 
     def run_rejoin(self):
@@ -343,9 +341,9 @@ class FormationChecks(unittest.TestCase):
         answer = spawn(name="follower_2", model="mbot", pose=Pose2DMsg(1.0, -3.0, 0.0))
         self.assertTrue(answer.success, answer.message)
         t_back = rospy.get_time()
-        p.wait(lambda: "follower_2" not in p.status.lost and "follower_2" in [s.robot for s in p.assignment.slots],
-               20.0, "follower_2 to rejoin")
-        p.wait(lambda: self.formed(0.3), 90.0, "the triangle formed again")
+        t_rejoined = p.wait(lambda: "follower_2" not in p.status.lost and "follower_2" in [
+            s.robot for s in p.assignment.slots], 20.0, "follower_2 to rejoin")
+        p.wait_switch_done("triangle", t_rejoined, 90.0)   # the new slots, as after a switch
         rospy.loginfo("rejoin: back in formation %.1f s after the respawn", rospy.get_time() - t_back)
         self.assertNoContacts()
 

@@ -13,12 +13,14 @@ def event(t, kind, name, detail=""):
 
 
 def sample(t, formation, slot_max, slot_rms=None):
+    """robot_1 slot_max off its slot (the leader robot_0 has no pose: it does not move)."""
     rms = slot_max if slot_rms is None else slot_rms
-    return Sample(t, "NAVIGATING", "robot_0", formation, (), rms, slot_max, NAN, NAN, NAN, NAN, NAN, NAN, "", {})
+    robots = {"robot_1": RobotSample(NAN, NAN, NAN, slot_max, NAN, 0.0, 0.0)}
+    return Sample(t, "NAVIGATING", "robot_0", formation, (), rms, slot_max, NAN, NAN, NAN, NAN, NAN, NAN, "", robots)
 
 
 def recorded_run():
-    """FORMING 10 -> 14.5 s; column at 50 s, within 0.3 m from 54.3 s; robot_2 silent from
+    """FORMING 10 -> 14.5 s; column at 50 s, within 0.3 m from 54.3 s on; robot_2 silent from
     80.0 s, lost at 81.1 s, slots re-planned at 81.1 s, slot RMS under 0.15 m from 84.0 s."""
     run = Run()
     run.events = [
@@ -31,7 +33,8 @@ def recorded_run():
         event(81.1, "loss", "robot_2"),
         event(81.1, "assignment", "wedge", "leader robot_0 spacing 1.5 m slots robot_0(0,0) robot_1(-1.06,1.06)"),
     ]
-    errors = {49.9: 0.01, 50.0: 1.8, 52.0: 0.9, 54.2: 0.31, 54.3: 0.29, 54.4: 0.2}
+    errors = {49.9: 0.01, 50.0: 1.8, 52.0: 0.9, 54.2: 0.31, 54.3: 0.29, 54.4: 0.2, 54.5: 0.2, 54.6: 0.2,
+              54.7: 0.2, 54.8: 0.2, 54.9: 0.2}
     run.samples = [sample(t, "triangle" if t < 50.0 else "column", e) for t, e in sorted(errors.items())]
     for k in range(0, 61):  # 80.0 .. 86.0 s: RMS 0.4 until 84.0, then 0.1
         t = round(80.0 + 0.1 * k, 1)

@@ -6,7 +6,8 @@ leader's plan) and keeps a `Run`:
   * one `Sample` at every multiple of 1/rate sim seconds, with the newest ground-truth pose of
     every robot at or before that time (taken when the first later pose arrives),
   * the `Event`s: state changes, assignments, switches (the formation changed; switch_done when
-    the coordinator saw the new shape stand), pauses (start, end), losses, rejoins, contacts,
+    the coordinator's switch was done, by the rule below), pauses (start, end), losses, rejoins,
+    contacts,
   * one `ControllerSample` per follower controller cycle.
 `summarize(run)` turns a Run into the numbers of metrics.json. `RunWriter` writes a Run to
 metrics.csv, events.csv, controller.csv and metrics.json; `load_run(output_dir)` reads them back
@@ -56,6 +57,18 @@ What the numbers mean (all times sim time unless marked wall):
                     tenth of a wall second is seconds of sim time), so the sample at t waits
                     until every robot's stream has passed t; a stream more than hold_back
                     behind the newest pose (a removed robot) is not waited for.
+  switch done       the one rule (settle.py, SWITCH_TOLERANCE, SWITCH_HOLD): every follower whose
+                    slot is not blocked within 0.3 m of its new slot, held 0.5 s; the switch time
+                    runs from the switch until that hold began. The coordinator applies it online
+                    (SwitchSettle; its switch_done event), switch_done_times(run) to a recorded
+                    run's samples (and gives the coordinator's time beside it); the scenario
+                    judge, the runner's `formed` event, the report, the benchmark and the
+                    rostests use them. Not the same as a stable formation (the coordinator's
+                    FORMING and ARRIVED also wait for headings) nor the report's settling (slot
+                    RMS under recovered_rms for recovered_hold, another figure).
+  leader's path     the path slots of a formation along the path lie on (trail.LeaderTrail): from
+                    the leader's pose at the assignment's time on, points 0.05 m apart, 50 m long;
+                    the coordinator, this collector, the fleet probe and the report build it alike.
   time in state     sim time between the coordinator's state changes, the last one up to the end.
   recovery          per loss (the status shows a new `lost` member at t0): time from t0 to the
                     state DEGRADED (0 if it already was), and the time from t0 until the slot RMS
@@ -64,8 +77,8 @@ What the numbers mean (all times sim time unless marked wall):
 Offline: `/usr/bin/python3 -m mbot_follower.metrics OUTPUT_DIR` prints the summary of a run.
 
 The code is split by role: `records` (the record types, MetricsConfig, Run), `collector` (the
-live recorder), `summary` (the statistics), `files` (CSV/JSON in and out); all of it is
-importable from mbot_follower.metrics.
+live recorder), `summary` (the statistics), `files` (CSV/JSON in and out), `settle` (when a
+switch is done); all of it is importable from mbot_follower.metrics.
 """
 import argparse
 import json
@@ -77,6 +90,7 @@ from mbot_follower.metrics.files import (CONTROLLER_COLUMNS, EVENT_COLUMNS, FILE
                                          sample_columns)
 from mbot_follower.metrics.records import (NAN, PLAN_STATES, ControllerSample, Event, MetricsConfig,  # noqa: F401
                                            RobotSample, Run, Sample)
+from mbot_follower.metrics.settle import SWITCH_HOLD, SWITCH_TOLERANCE, SwitchSettle, switch_done_times  # noqa: F401
 from mbot_follower.metrics.summary import (_holds_under, finite_rms, leader_speed, recoveries,  # noqa: F401
                                            run_span, state_at, summarize, time_in_states)
 

@@ -9,7 +9,7 @@ from mbot_follower.control_laws import energy_rate
 from mbot_follower.metrics import obstacles as static_obstacles
 from mbot_follower.metrics.records import NAN, ControllerSample, Event, MetricsConfig, RobotSample, Run, Sample
 from mbot_follower.shape import ShapeErrors, rigid_fit, shape_errors
-from mbot_follower.trail import Trail, slot_pose
+from mbot_follower.trail import LeaderTrail, slot_pose, trail_start
 
 
 def distance_to_polyline(x, y, points):
@@ -52,9 +52,9 @@ class MetricsCollector(object):
         self._assignments = []
         self._statuses = []
         self._next_tick = None   # the next sample is at _next_tick / rate [s]
-        # The leader's ground-truth path at the sample times since the assignment in force
-        # (_trail_of), for the slots of a formation along the path.
-        self._trail = Trail()
+        # The leader's ground-truth path (trail.LeaderTrail) at the sample times since the
+        # assignment in force (_trail_of), for the slots of a formation along the path.
+        self._trail = LeaderTrail()
         self._trail_of = None
         # The simulator's static obstacles (obstacles.Obstacle by name) and (t, tuple) of every
         # change: a slot beside one is blocked as one beside a wall (on_obstacles).
@@ -288,7 +288,7 @@ class MetricsCollector(object):
         """Record the leader's pose on its trail; a new assignment `a` (in force since `since`)
         starts the trail where the leader was then."""
         if a is not self._trail_of:
-            start = self._pose_at(leader, since)
-            self._trail.start(*(start[1:4] if start is not None else pose))
+            start = trail_start(self.history.get(leader, ()), since)
+            self._trail.restart(since, start[1:4] if start is not None else pose)
             self._trail_of = a
-        self._trail.add(pose[0], pose[1])
+        self._trail.follow(*pose)
