@@ -201,7 +201,7 @@ class FleetCoordinator(object):
 
     @property
     def switching(self):
-        """A formation switch is under way: from its request until the new shape stands."""
+        """A formation switch is under way: from its request until the new shape stands (metrics.settle)."""
         return self._switch_started is not None
 
     def state(self):
