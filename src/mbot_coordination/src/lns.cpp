@@ -7,7 +7,8 @@
 
 namespace mbot_coordination
 {
-LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadline, unsigned seed, int neighbourhood)
+LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadline, unsigned seed, int neighbourhood,
+                   long max_iterations)
 {
   LnsStats stats;
   const Grid& g = *inst.grid;
@@ -21,7 +22,7 @@ LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadlin
   const int size = std::min(neighbourhood, n);
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
-  while (soc > bound && Clock::now() < deadline)
+  while (soc > bound && Clock::now() < deadline && (max_iterations < 0 || stats.iterations < max_iterations))
   {
     ++stats.iterations;
     // Seed: an agent that is late, picked with probability by its delay; then the agents on its

@@ -1,19 +1,26 @@
 """Central dispatch: which robot drives to which goal, no formation.
 
-Given the robots' positions and a list of goals (at most one per robot), every goal gets one
-robot so that the total path length is smallest: the Hungarian method
-(`scipy.optimize.linear_sum_assignment`) on a table of path lengths. A path length is the
-shortest way through the map for a robot of `robot_radius` (8-connected grid, no corner
-cutting: `mbot_navigation.grid_paths`), not the straight line: in a warehouse the robot across
-a shelf is far away. Robots without a goal stay where they are. Pure numpy/scipy, no ROS
-(dispatcher_node.py is the node).
+Goals arrive in a queue (`DispatchQueue`), at any time, more of them than robots if need be.
+Whenever robots are free (a new fleet, a goal reached or failed, new goals), the oldest pending
+goals, as many as there are free robots, are given out by one of two policies:
+
+- ``hungarian``: the least total path cost, the Hungarian method
+  (`scipy.optimize.linear_sum_assignment`) on a table of costs robot x goal;
+- ``round_robin``: the goals in order to the robots in turn, skipping a robot that cannot reach
+  the goal (the simple baseline a fleet manager offers for a class of equal tasks).
+
+The costs come from outside: the node asks each robot's own planner (move_base's ``make_plan``:
+its costmap, its teammates); `path_length_table` measures through the map instead (8-connected
+grid, no corner cutting: `mbot_navigation.grid_paths`), not the straight line: in a warehouse
+the robot across a shelf is far away. Taking the oldest goals first means no goal waits for
+ever behind nearer ones. A goal whose robot fails (move_base aborts) goes back to the front of the
+queue for the other robots. Pure numpy/scipy, no ROS (dispatcher_node.py is the node).
 """
 import math
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from mbot_follower.free_space import FreeSpace
 from mbot_navigation.grid_paths import path_lengths_from
 
 
@@ -55,34 +62,116 @@ def path_length_table(free, resolution, origin_xy, robots, goals):
     return table
 
 
-def assign_goals(table):
-    """{goal index: robot index} with the least total path length over the table
-    (path_length_table: robots x goals). DispatchError when there are more goals than robots or
-    a goal no robot can reach."""
+POLICIES = ("hungarian", "round_robin")
+
+
+def best_pairs(table):
+    """[(robot index, goal index)] of the least total cost over a table robots x goals that may
+    hold inf (unreachable) and have more goals than robots: as many pairs as can be made
+    without an unreachable one."""
     table = np.asarray(table, dtype=float)
-    robots, goals = table.shape
-    if goals > robots:
-        raise DispatchError("%d goals for %d robots: at most one goal per robot" % (goals, robots))
-    for j in range(goals):
-        if not np.isfinite(table[:, j]).any():
-            raise DispatchError("goal %d: no robot can reach it (in a wall, or cut off)" % j)
-    # an unreachable pair must never be chosen while a reachable one exists: make it dearer than all
+    if table.size == 0:
+        return []
     finite = table[np.isfinite(table)]
-    big = (finite.sum() + 1.0) * 10.0 if len(finite) else 1.0
-    cost = np.where(np.isfinite(table), table, big)
-    rows, cols = linear_sum_assignment(cost)
-    assignment = {int(j): int(i) for i, j in zip(rows, cols)}
-    for j, i in assignment.items():
-        if not np.isfinite(table[i, j]):
-            raise DispatchError("goal %d: no robot left that can reach it" % j)
-    return assignment
+    if not len(finite):
+        return []
+    big = (finite.sum() + 1.0) * 10.0
+    rows, cols = linear_sum_assignment(np.where(np.isfinite(table), table, big))
+    return [(int(i), int(j)) for i, j in zip(rows, cols) if np.isfinite(table[i, j])]
 
 
-def dispatch(world_map, occupancy, robots, goals, config=None):
-    """{goal index: robot index} for robots [(x, y)] and goals [(x, y)] [m] on a map
-    (mbot_common.maps.MapData for its resolution and origin; `occupancy` its grid, possibly with
-    obstacles added), and the path length table."""
-    config = config or DispatchConfig()
-    space = FreeSpace(occupancy, world_map.resolution, world_map.origin[:2], config.robot_radius + config.margin)
-    table = path_length_table(space.free, world_map.resolution, world_map.origin[:2], robots, goals)
-    return assign_goals(table), table
+class Goal(object):
+    """A goal in the queue: id (its order of arrival), pose [m, rad], the robots that failed it."""
+
+    def __init__(self, goal_id, x, y, yaw):
+        self.id, self.x, self.y, self.yaw = goal_id, x, y, yaw
+        self.failed_by = set()
+
+    def __repr__(self):
+        return "goal %d (%.2f, %.2f)" % (self.id, self.x, self.y)
+
+
+class DispatchQueue(object):
+    """The goals waiting, the goal each robot drives to, and who gets what next (see the module).
+
+    Not thread-safe: the node holds one lock around every call."""
+
+    def __init__(self, robots, policy="hungarian"):
+        if policy not in POLICIES:
+            raise DispatchError("unknown dispatch policy %r: expected one of %s" % (policy, ", ".join(POLICIES)))
+        self.robots = list(robots)
+        self.policy = policy
+        self.pending = []      # Goals in the order they came (a failed one back at the front)
+        self.active = {}       # robot -> its Goal
+        self.dropped = []      # (Goal, why): every robot failed it
+        self._next_id = 0
+        self._turn = 0         # round_robin: index of the robot whose turn is next
+
+    def add(self, poses):
+        """Queue goals [(x, y, yaw)]; returns their Goals."""
+        goals = []
+        for (x, y, yaw) in poses:
+            goals.append(Goal(self._next_id, float(x), float(y), float(yaw)))
+            self._next_id += 1
+        self.pending.extend(goals)
+        return goals
+
+    def free_robots(self, available):
+        """The robots of `available` (those with a known pose) that drive to no goal."""
+        return [r for r in self.robots if r in available and r not in self.active]
+
+    def assign(self, free, costs):
+        """Give pending goals to the `free` robots; returns [(robot, Goal, cost)] (they are active
+        from now on). costs(robots, goals) -> table robots x goals [m], inf where a robot cannot
+        reach a goal. The oldest goals first, one per free robot: a goal that none of them can
+        reach (or that they failed) waits for the others and does not hold up the goals behind
+        it; when every robot is free and none can reach it, it is dropped (see `dropped`)."""
+        free = [r for r in free if r not in self.active]
+        window, columns = [], []
+        for goal in list(self.pending):
+            if len(window) == len(free):
+                break
+            column = np.asarray(costs(free, [goal]), dtype=float).reshape(len(free))
+            column[[r in goal.failed_by for r in free]] = np.inf
+            if np.isfinite(column).any():
+                window.append(goal)
+                columns.append(column)
+            elif not self.active and set(free) | goal.failed_by >= set(self.robots):
+                self.pending.remove(goal)
+                self.dropped.append((goal, "no robot can reach it"))
+        if not window:
+            return []
+        table = np.column_stack(columns)
+        if self.policy == "hungarian":
+            pairs = best_pairs(table)
+        else:
+            pairs, taken = [], set()
+            for j in range(len(window)):
+                for k in range(len(self.robots)):
+                    robot = self.robots[(self._turn + k) % len(self.robots)]
+                    if robot in free and robot not in taken and np.isfinite(table[free.index(robot), j]):
+                        pairs.append((free.index(robot), j))
+                        taken.add(robot)
+                        self._turn = (self.robots.index(robot) + 1) % len(self.robots)
+                        break
+        given = []
+        for i, j in sorted(pairs, key=lambda p: p[1]):
+            robot, goal = free[i], window[j]
+            self.active[robot] = goal
+            self.pending.remove(goal)
+            given.append((robot, goal, float(table[i, j])))
+        return given
+
+    def done(self, robot, succeeded):
+        """The robot's goal ended. A failed goal goes back to the front of the queue for the other
+        robots, or is dropped (returned with the reason) when every robot has failed it."""
+        goal = self.active.pop(robot, None)
+        if goal is None or succeeded:
+            return None
+        goal.failed_by.add(robot)
+        if set(self.robots) <= goal.failed_by:
+            why = "every robot failed it (%s)" % ", ".join(sorted(goal.failed_by))
+            self.dropped.append((goal, why))
+            return why
+        self.pending.insert(0, goal)
+        return None

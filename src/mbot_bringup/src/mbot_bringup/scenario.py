@@ -70,7 +70,8 @@ CRITERIA = {
     "losses": (">=", int, "robots lost"),
     "rejoins": (">=", int, "robots that rejoined"),
     "max_switch_time_s": ("<=", float, "longest time from a switch until the new shape stood [s]"),
-    "max_loss_detection_s": ("<=", float, "longest time from a kill_controller or remove_robot step to DEGRADED [s]"),
+    "max_loss_detection_s": ("<=", float, "longest time from a step that takes a robot out (kill_controller, "
+                             "remove_robot, a fault drive_frozen or silenced) to DEGRADED [s]"),
     "max_time_to_degraded_s": ("<=", float, "longest time from a loss (the status names it lost) to DEGRADED [s]"),
     "max_recovery_time_s": ("<=", float, "longest time from a loss until the slot RMS settled [s]"),
     "duration_s": ("<=", float, "sim time the metrics cover [s]"),
@@ -439,11 +440,6 @@ def check_against_world(scenario, robot_names):
                 make_formation(name, len(robot_names), spacing, scenario.topology)
             except FormationError as error:
                 raise ConfigError("%s: %s: %s" % (scenario.path, key, error))
-    if scenario.mode == "dispatch":
-        for s in scenario.steps("dispatch"):
-            if len(s.arg) > len(robot_names):
-                raise ConfigError("%s: %s.do.dispatch: %d goals for %d robots (one goal per robot at a time)" % (
-                    scenario.path, s.key, len(s.arg), len(robot_names)))
 
 
 # --- the timeline ---------------------------------------------------------------------------
@@ -546,13 +542,21 @@ def _largest(values):
     return max(values)
 
 
+def takes_a_robot_out(step):
+    """Whether a step takes a robot out of the fleet: its controller killed, the robot removed, or
+    a fault that freezes its drive (its motors fail) or silences it (no odom, tf or scan)."""
+    return step.action in ("kill_controller", "remove_robot") or \
+        (step.action == "fault" and (step.arg["drive_frozen"] or step.arg["silenced"]))
+
+
 def loss_detection_times(timeline):
-    """For every kill_controller and remove_robot step that ran: the time [s] from the step to the
-    next `degraded` event (None: never). What the coordinator's loss detection takes, seen from
-    outside (the metrics' own time_to_degraded starts when the status already names the loss)."""
+    """For every step that ran and takes a robot out (takes_a_robot_out): the time [s] from the
+    step to the next `degraded` event (None: never). What the coordinator's loss detection takes,
+    seen from outside (the metrics' own time_to_degraded starts when the status already names the
+    loss)."""
     out = []
     for step, t in timeline.fired:
-        if step.action in ("kill_controller", "remove_robot"):
+        if takes_a_robot_out(step):
             later = [te for (name, te) in timeline.events if name == "degraded" and te >= t]
             out.append(min(later) - t if later else None)
     return out

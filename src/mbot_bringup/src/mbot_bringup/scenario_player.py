@@ -59,6 +59,11 @@ class ScenarioPlayer(object):
             rospy.Subscriber("/%s/move_base/result" % r, MoveBaseActionResult, self._on_result, callback_args=r,
                              queue_size=20)
             rospy.Subscriber("/%s/move_base/goal" % r, MoveBaseActionGoal, self._on_goal, queue_size=20)
+        # The dispatcher's queue (dispatcher_node: a line per robot driving or goal waiting; empty: idle)
+        self.dispatcher_idle = True
+        self.busy_since_step = False   # the dispatcher had work after the newest dispatch step
+        from std_msgs.msg import String
+        rospy.Subscriber("/dispatch/assignment", String, self._on_dispatch_queue, queue_size=10)
         self.t0 = None
         self.log = []              # what each step did: {t_s, step, when, action, ok, message}
         self.failed_steps = 0
@@ -82,6 +87,12 @@ class ScenarioPlayer(object):
     def _on_result(self, msg, robot):
         with self.probe.lock:
             self.results.append((self.rospy.get_time(), robot, msg.status.status, msg.status.goal_id.id))
+
+    def _on_dispatch_queue(self, msg):
+        with self.probe.lock:
+            self.dispatcher_idle = not msg.data.strip()
+            if not self.dispatcher_idle and self.round_size is not None:
+                self.busy_since_step = True
 
     def _on_goal(self, msg):
         with self.probe.lock:
@@ -156,10 +167,13 @@ class ScenarioPlayer(object):
             self.timeline.observe("formed", t)
 
         if self.round_size is not None and not self.goals_done_sent:
-            goals = self.round_size
+            # done: the dispatcher had the step's goals, has no goal left (none driven, none
+            # waiting: it may queue more goals than robots, and refuse some) and every goal it
+            # sent since the step has its result
             with self.probe.lock:
                 round_goals = set(self.round_goals)
-            if len(round_ended(results, round_goals)) >= goals:
+                idle = self.busy_since_step and self.dispatcher_idle
+            if idle and round_goals and len(round_ended(results, round_goals)) >= len(round_goals):
                 self.goals_done_sent = True
                 self.timeline.observe("goals_done", t)
 
@@ -270,10 +284,11 @@ class ScenarioPlayer(object):
                 msg.poses.append(pose)
             with self.probe.lock:
                 self.round_goals = set()  # before the dispatcher can send the first of them
+                self.busy_since_step = False
+                self.round_size = len(a)
+                self.goals_done_sent = False
             self.dispatch_pub.publish(msg)
             self.dispatched += len(a)
-            self.round_size = len(a)
-            self.goals_done_sent = False
             self._shot_later(t + 5.0, "dispatch")
             return True, "sent %d goals" % len(a)
         if step.action == "screenshot":

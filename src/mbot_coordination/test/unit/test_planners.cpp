@@ -239,7 +239,9 @@ TEST(Lns, ImprovesAndKeepsTheSolutionValid)
   const PlanResult pp = solve("pp", inst);
   ASSERT_TRUE(pp.solved) << pp.message;
   Paths paths = pp.paths;
-  const auto stats = refineLns(inst, paths, Clock::now() + std::chrono::milliseconds(300), 1);
+  // 100 iterations (the 20 s deadline only guards against a hang): the same on a busy machine
+  const auto stats = refineLns(inst, paths, Clock::now() + std::chrono::seconds(20), 1, 8, 100);
+  EXPECT_EQ(stats.iterations, 100);
   EXPECT_GT(stats.improvements, 0);
   EXPECT_LT(sumOfCosts(paths), sumOfCosts(pp.paths));
   EXPECT_GE(sumOfCosts(paths), lowerBound(inst));
