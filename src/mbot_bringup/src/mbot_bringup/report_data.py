@@ -285,8 +285,12 @@ def slot_positions(assignment, leader_pose, trail=None):
 def leader_trail(series, assignment, i):
     """The leader's path (trail.LeaderTrail) of the assignment up to sample i, from the samples:
     the path its slots lie on when it is along the path (None without a pose)."""
-    poses = [(series.t[j] + series.t0,) + series.pose(assignment.leader, j) for j in range(i + 1)
-             if series.pose(assignment.leader, j) is not None]
+    # from the newest sample with a leader pose not later than the assignment on
+    first = int(np.searchsorted(series.t + series.t0, assignment.t + 1e-9, side="right")) - 1
+    while first > 0 and series.pose(assignment.leader, first) is None:
+        first -= 1
+    poses = [(series.t[j] + series.t0,) + p for j, p in
+             ((j, series.pose(assignment.leader, j)) for j in range(max(first, 0), i + 1)) if p is not None]
     start = trail_start(poses, assignment.t)
     if start is None:
         return None
