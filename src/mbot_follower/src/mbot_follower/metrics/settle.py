@@ -10,7 +10,10 @@ reached, i.e. the start of that hold: the hold is the proof, not part of the swi
 `SwitchSettle` applies the rule to one stream of slot errors (the coordinator feeds it every
 cycle); `switch_done_times(run)` feeds the same class with a recorded run's samples, once per
 switch, and adds what the coordinator itself recorded (its switch_done event), so both can be
-compared.
+compared. Only their inputs differ: the coordinator measures its localization's poses and leaves
+out its blocked followers (a wall's slot until free_hold after it is clear, a slot beside a lost
+robot); a recorded run has the ground truth at the sample rate and the collector's slot_free
+(walls and obstacles, in that sample); the fleet probe of the rostests counts every follower.
 
 Headings are not part of it: "formation stable" (FORMING -> NAVIGATING, ARRIVED; the
 coordinator's edge and heading tolerances) also waits for followers that drove backwards into
