@@ -14,8 +14,9 @@
     scripts/bench formation [--json FILE] [--seeds N] [--sizes 3,5,10]
                                       the formation fleet at real_time_factor 0 with lockstep:
                                       convergence, straight and route slot error, switch time,
-                                      recovery after a loss, contacts, controller cycle time
-                                      (mbot_follower/formation_bench.py)
+                                      recovery after a loss, contacts, controller cycle time;
+                                      for 3 robots also the office route (doors, corridor) as
+                                      the row "3 office" (mbot_follower/formation_bench.py)
     scripts/bench fleet [--json FILE] [--sizes 3,10,20,40] [--modes formation,navigation]
                                       what the fleet around the simulator costs: real-time
                                       factor, CPU s per robot per sim s and each process kind's
@@ -269,15 +270,17 @@ def print_table(result):
     if "formation" in result:
         print("\nFormation (worst over seeds; targets: straight <= 0.05 m, route <= 0.15 m, converge <= 10 s,"
               " switch <= 6 s, DEGRADED <= 2 s, re-converged <= 10 s, 0 contacts)")
-        print("  %-6s %9s %9s %11s %10s %11s %8s %10s %10s %9s %10s" % (
+        print("  %-8s %9s %9s %11s %10s %11s %8s %10s %10s %9s %10s" % (
             "robots", "succeeded", "contacts", "straight m", "route m", "converge s", "switch s",
             "degraded s", "recover s", "cycle p99", "wall s"))
-        for n, r in result["formation"].items():
+        rows = [(n, r) for n, r in result["formation"].items()]
+        rows += [("%s office" % n, r) for n, r in result.get("formation_office", {}).items()]   # the office route
+        for n, r in rows:
             wall = max((d.get("wall_s") or 0) for d in r.get("details", [{}]))
 
             def f(key, fmt):
                 return fmt % r[key] if r.get(key) is not None else "-"
-            print("  %-6s %9s %9d %11s %10s %11s %8s %10s %10s %9s %10.0f" % (
+            print("  %-8s %9s %9d %11s %10s %11s %8s %10s %10s %9s %10.0f" % (
                 n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
                 f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
                 f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))

@@ -32,6 +32,15 @@ The formation is ``diamond`` (``triangle`` for 3 robots: a diamond needs 4), spa
 A row of the table is the worst value over the seeds; ``succeeded`` counts runs in which every
 step finished (ARRIVED at every target, DEGRADED after the kill).
 
+The **office route** is a row of its own (``office`` in the output, 3 robots: the office world's;
+its rooms hold no more at this spacing): the demo's route (the scenario ``office_route``) in
+``office``, a triangle of 1 m formed in the south-east room, driven to its door (5, -3.5), a
+switch to ``column``, through the 1.2 m door, the corridor and the north-east room's door to
+(7.7, 3.5), and the triangle again. **rms_route_m** is measured as in 2 from the first target
+to the last arrival (doors, corridor and both turns), **converge_s** as in 1, **switch_s** as in
+3 (triangle -> column, standing at the door), **route_s** is the sim time from the first target
+to the last arrival; the world's seed is the run's seed.
+
 The parent process runs one child process per run (rospy allows one node per process).
 """
 import argparse
@@ -55,6 +64,8 @@ LEADER_START = (-14.0, -10.0)  # [m] facing east; further east for deep formatio
 START_RADIUS = 2.0             # [m] followers start within this of their slots
 MIN_GAP = 0.6                  # [m] centre distance between any two starting robots
 ROOM = 19.0                    # [m] starting places stay within +-ROOM
+OFFICE_SIZES = (3,)            # the office route: the office world's three robots
+OFFICE_SPACING = 1.0           # [m] a triangle of 1 m fits the office's rooms (as office_route)
 
 
 def formation_for(n):
@@ -92,6 +103,40 @@ def world_yaml(poses, map_path):
     return "\n".join(lines) + "\n"
 
 
+def office_world_yaml(seed, maps_dir):
+    """The office world with its map path absolute and the run's seed."""
+    with open(os.path.join(maps_dir, "office.world.yaml")) as f:
+        lines = f.read().splitlines()
+    out = []
+    for line in lines:
+        if line.startswith("map:"):
+            line = "map: %s" % os.path.join(maps_dir, "office.yaml")
+        elif line.startswith("seed:"):
+            line = "seed: %d" % seed
+        elif line.startswith("real_time_factor:"):
+            line = "real_time_factor: 0.0"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def office_timings(run, route):
+    """converge_s, switch_s [s] and rms_route_m [m] of an office run from the metrics collector's
+    Run; route: (start, end) sim time [s] from the first target to the last arrival."""
+    from mbot_follower.metrics import switch_done_times
+
+    events = sorted(run.events, key=lambda e: e.t)
+    out = {"converge_s": None, "switch_s": None, "rms_route_m": moving_rms(run, route[0], route[1])}
+    done = next((d["switch_time_s"] for d in switch_done_times(run) if d["formation"] == "column"), None)
+    if done is not None:
+        out["switch_s"] = round(done, 2)
+    forming = next((e.t for e in events if e.kind == "state" and e.name == "FORMING"), None)
+    navigating = next((e.t for e in events if e.kind == "state" and e.name == "NAVIGATING"
+                       and forming is not None and e.t >= forming), None)
+    if navigating is not None:
+        out["converge_s"] = round(navigating - forming, 2)
+    return out
+
+
 def worst(runs):
     """One table row from the runs of a fleet size: worst value per measure, success counted."""
     row = {"runs": len(runs), "succeeded": sum(1 for r in runs if r.get("succeeded")),
@@ -99,7 +144,7 @@ def worst(runs):
            "overruns": sum(r.get("overruns") or 0 for r in runs),
            "late_starts": sum(r.get("late_starts") or 0 for r in runs)}
     for key in ("rms_straight_m", "rms_route_m", "converge_s", "switch_s", "degraded_s", "recover_s",
-                "cycle_p99_ms"):
+                "cycle_p99_ms", "route_s"):
         values = [r[key] for r in runs if r.get(key) is not None]
         row[key] = round(max(values), 4) if values else None
     return row
@@ -251,6 +296,45 @@ def drive(n, seed, log):
     return result
 
 
+def drive_office(n, seed, log):
+    """The office route on the fleet already launched (module docstring); returns what the probe
+    saw (contacts, the route's window)."""
+    import rospy
+    from std_msgs.msg import String
+
+    from mbot_follower.fleet_probe import FleetProbe
+
+    probe = FleetProbe(["robot_%d" % i for i in range(n)], pace=True)
+    probe.wait_for_fleet(wall_timeout=300.0)
+    result = {"n": n, "seed": seed, "succeeded": False}
+
+    def arrive(x, y, theta, what):
+        probe.send_target(x, y, theta)
+        probe.wait(lambda: probe.state() in ("FORMING", "NAVIGATING"), 20.0, "%s to be taken" % what)
+        probe.wait(lambda: probe.state() in ("ARRIVED", "ABORTED"), 400.0, what)
+        if probe.state() != "ARRIVED":
+            raise RuntimeError("%s: %s (%s)" % (what, probe.state(), probe.status.reason))
+
+    def switch(formation):
+        t_switch = rospy.get_time()
+        probe.formation_pub.publish(String(formation))
+        probe.wait(lambda: probe.assignment is not None and probe.assignment.formation == formation, 10.0, formation)
+        probe.wait_switch_done(formation, t_switch, 60.0)
+
+    t_route = rospy.get_time()
+    arrive(5.0, -3.5, math.pi / 2, "the south-east room's door")
+    switch("column")
+    arrive(7.7, 3.5, math.pi / 2, "the north-east room, through the doors and the corridor")
+    result["route"] = (t_route, rospy.get_time())
+    result["route_s"] = round(result["route"][1] - result["route"][0], 2)
+    log("n=%d seed=%d: office route in %.1f s sim" % (n, seed, result["route_s"]))
+    switch("triangle")
+    result["contacts"] = len(probe.contacts)
+    result["succeeded"] = probe.state() == "ARRIVED"
+    wait_for_record(rospy.get_time(), 120.0, log)
+    return result
+
+
 def wait_for_record(until, wall_timeout, log):
     """Wait (wall time) until the metrics collector's record reaches sim time `until`. On a busy
     machine it lags behind the fleet (the simulator's lockstep waits for its heartbeat at most 2 s
@@ -278,23 +362,28 @@ def wait_for_record(until, wall_timeout, log):
     return False
 
 
-def run_one(n, seed, out_dir, log):
-    """Launch the fleet for (n, seed) on a private master, drive it, stop it. Returns measures."""
+def run_one(n, seed, out_dir, log, office=False):
+    """Launch the fleet for (n, seed) on a private master, drive it (office: the office route),
+    stop it. Returns measures."""
     from mbot_common.paths import find_maps_directory
     from mbot_navigation.nav_trial import free_port, stop, wait_for_sim_time
 
-    run_dir = os.path.join(out_dir, "n%d_seed%d" % (n, seed))
+    run_dir = os.path.join(out_dir, "%sn%d_seed%d" % ("office_" if office else "", n, seed))
     shutil.rmtree(run_dir, ignore_errors=True)
     os.makedirs(run_dir)
     world = os.path.join(run_dir, "world.yaml")
     with open(world, "w") as f:
-        f.write(world_yaml(start_poses(n, seed), os.path.join(find_maps_directory(), MAP)))
+        if office:
+            f.write(office_world_yaml(seed, find_maps_directory()))
+        else:
+            f.write(world_yaml(start_poses(n, seed), os.path.join(find_maps_directory(), MAP)))
     port = free_port()
     os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
     os.environ.pop("ROS_IP", None)
     launch_log = os.path.join(run_dir, "roslaunch.log")
     cmd = ["roslaunch", "-p", str(port), "mbot_follower", "formation.launch", "world:=" + world,
-           "formation:=" + formation_for(n), "spacing:=%g" % SPACING, "real_time_factor:=0", "lockstep:=true",
+           "formation:=" + formation_for(n), "spacing:=%g" % (OFFICE_SPACING if office else SPACING),
+           "real_time_factor:=0", "lockstep:=true",
            "metrics_dir:=" + os.path.join(run_dir, "metrics")]
     with open(launch_log, "w") as f:
         process = subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
@@ -305,7 +394,7 @@ def run_one(n, seed, out_dir, log):
         wait_for_sim_time("formation_bench", launch_log, wall_timeout=120.0)
         rospy.init_node("formation_bench", disable_signals=True)
         started = time.time()
-        result = drive(n, seed, log)
+        result = (drive_office if office else drive)(n, seed, log)
         result["wall_s"] = round(time.time() - started, 1)
     except Exception as error:  # a failed run is a row of the table, not a crash of the benchmark
         result["error"] = str(error).splitlines()[0]
@@ -323,12 +412,17 @@ def run_one(n, seed, out_dir, log):
         result["late_starts"] = fleet.get("cycle_late_starts")
         result["contacts"] = max(result.get("contacts", 0), fleet.get("contacts") or 0)
         try:
-            result.update(timings(load_run(os.path.dirname(metrics)), result.get("route")))
+            if office:
+                record = load_run(os.path.dirname(metrics))
+                result.update(office_timings(record, result["route"]) if "route" in result else {})
+            else:
+                result.update(timings(load_run(os.path.dirname(metrics)), result.get("route")))
         except RunFileError as error:
             result["error"] = "the metrics record: %s" % error
             result["succeeded"] = False
-        missing = [k for k in ("converge_s", "switch_s", "degraded_s", "recover_s", "rms_straight_m", "rms_route_m")
-                   if result.get(k) is None]
+        needed = ("converge_s", "switch_s", "rms_route_m") if office else \
+            ("converge_s", "switch_s", "degraded_s", "recover_s", "rms_straight_m", "rms_route_m")
+        missing = [k for k in needed if result.get(k) is None]
         if result.get("succeeded") and missing:
             result["error"] = "the metrics record lacks %s" % ", ".join(missing)
             result["succeeded"] = False
@@ -347,6 +441,7 @@ def parse_args(argv):
                         help="run folders (world, launch log, metrics)")
     parser.add_argument("--json", action="store_true", help="print the table as one JSON line")
     parser.add_argument("--one", nargs=2, type=int, metavar=("N", "SEED"), help=argparse.SUPPRESS)
+    parser.add_argument("--office", action="store_true", help=argparse.SUPPRESS)   # --one: the office route
     return parser.parse_args(argv)
 
 
@@ -358,22 +453,29 @@ def main(argv=None):
         sys.stderr.flush()
 
     if args.one:  # child: one run, its measures as the last line of stdout
-        print(json.dumps(run_one(args.one[0], args.one[1], args.out, log)))
+        print(json.dumps(run_one(args.one[0], args.one[1], args.out, log, office=args.office)))
         return 0
-    table = {}
-    for n in [int(s) for s in args.sizes.split(",")]:
+
+    def row(n, office):
         runs = []
         for seed in range(args.first_seed, args.first_seed + args.seeds):
             out = subprocess.run([sys.executable, "-m", "mbot_follower.formation_bench", "--one", str(n), str(seed),
-                                  "--out", args.out], stdout=subprocess.PIPE, universal_newlines=True)
+                                  "--out", args.out] + (["--office"] if office else []),
+                                 stdout=subprocess.PIPE, universal_newlines=True)
             lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
             run = json.loads(lines[-1]) if lines else {
                 "n": n, "seed": seed, "succeeded": False, "error": "the run printed nothing (exit %d)" % out.returncode}
-            log("n=%d seed=%d: %s" % (n, seed, json.dumps(run)))
+            log("%sn=%d seed=%d: %s" % ("office " if office else "", n, seed, json.dumps(run)))
             runs.append(run)
-        table[str(n)] = worst(runs)
-        table[str(n)]["details"] = runs
-    result = {"formation": table}
+        out = worst(runs)
+        out["details"] = runs
+        return out
+
+    sizes = [int(s) for s in args.sizes.split(",")]
+    table = {str(n): row(n, False) for n in sizes}
+    # the office route: its own row, for the sizes the office world holds
+    office = {str(n): row(n, True) for n in sizes if n in OFFICE_SIZES}
+    result = {"formation": table, "formation_office": office}
     if args.json:
         print(json.dumps(result))
     else:

@@ -143,3 +143,37 @@ def test_the_slot_rms_comes_from_the_record_while_the_leader_moves():
     run.samples[300] = moving_sample(40.0, "DEGRADED", run.samples[300].robots["robot_0"].x, {"robot_1": 1.8})
     assert timings(run)["rms_straight_m"] > 0.05
     assert moving_rms(run, 30.0, 31.0) is None   # the leader stood still
+
+
+def test_the_office_row_runs_the_office_world_with_the_runs_seed(tmp_path):
+    """The office route's world: the office's three robots where the world file has them, its
+    crate and person, the map path absolute, the run's seed, as fast as possible."""
+    from mbot_common.paths import find_maps_directory
+    from mbot_common.world import load_world
+    from mbot_follower.formation_bench import office_world_yaml
+
+    path = tmp_path / "world.yaml"
+    path.write_text(office_world_yaml(7, find_maps_directory()))
+    world, office = load_world(str(path)), load_world(find_maps_directory() + "/office.world.yaml")
+    assert world.seed == 7 and world.real_time_factor == 0.0
+    assert world.robots == office.robots and world.obstacles == office.obstacles
+    assert world.map_data.width == office.map_data.width
+
+
+def test_the_office_row_is_timed_from_the_record():
+    """FORMING 10 -> 14.5 s (converge 4.5 s); the route's RMS over its window only."""
+    from mbot_follower.formation_bench import office_timings
+
+    run = recorded_run()
+    x = 0.0
+    run.samples = []
+    for k in range(0, 400):   # 10 Hz from 10 s to 50 s
+        t = round(10.0 + 0.1 * k, 1)
+        x += 0.05 if t >= 14.5 else 0.0
+        errors = {"robot_1": 0.1, "robot_2": 0.1} if 20.0 <= t < 40.0 else {"robot_1": 1.0, "robot_2": 1.0}
+        run.samples.append(moving_sample(t, "FORMING" if t < 14.5 else "NAVIGATING", x, errors))
+    got = office_timings(run, (20.0, 40.0))
+    assert got["converge_s"] == 4.5
+    assert math.isclose(got["rms_route_m"], 0.1)
+    assert got["switch_s"] is None   # no switch in this record
+    assert office_timings(Run(), (20.0, 40.0)) == {"converge_s": None, "switch_s": None, "rms_route_m": None}
