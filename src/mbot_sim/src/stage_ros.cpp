@@ -113,6 +113,7 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   contact_pub_ = nh_.advertise<mbot_msgs::Contact>("contacts", 100);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("stage/markers", 1, true);
+  applied_pub_ = nh_.advertise<mbot_msgs::AppliedCommands>("stage/applied_commands", 10);
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
   for (int id : world_->robotIds()) addRobotIo(id);
   publishRobotList();
@@ -260,6 +261,47 @@ void StageRos::publishClock()
   clock_pub_.publish(clock);
 }
 
+/// Before a step: the cmd_vels that arrived since the step before are used from now on (the newest
+/// of each robot; one replaced before any step was never applied and is not reported).
+void StageRos::noteAppliedCommands()
+{
+  const ros::Time now = ros::Time().fromSec(world_->time());
+  for (auto& io : io_)
+  {
+    if (!io || !io->cmd_pending) continue;
+    io->cmd_pending = false;
+    if (!report_applied_) continue;  // nobody listens: only the flag is kept current
+    mbot_msgs::AppliedCommand c;
+    c.robot = io->name;
+    c.received.fromSec(io->cmd_received);
+    c.applied = now;
+    c.cmd = io->cmd_msg;
+    applied_batch_.commands.push_back(c);
+  }
+}
+
+/// After a step: every kAppliedCommandsPeriod of sim time, the commands applied since the last
+/// message, stamped with the sim time now, also when there were none, so that a listener knows
+/// how far the report goes (`since` to the stamp). Nothing is collected while nobody subscribes
+/// (checked here, once per period); the report then starts again with a new `since`.
+void StageRos::publishAppliedCommands()
+{
+  const double t = world_->time();
+  const bool went_back = t + kAppliedCommandsPeriod < next_applied_time_ - 1e-9;
+  if (t + 1e-9 < next_applied_time_ && !went_back) return;
+  next_applied_time_ = (std::floor((t + 1e-9) / kAppliedCommandsPeriod) + 1.0) * kAppliedCommandsPeriod;
+  if (report_applied_)
+  {
+    applied_batch_.header.stamp.fromSec(t);
+    applied_pub_.publish(applied_batch_);
+    applied_batch_.commands.clear();
+    applied_batch_.since = applied_batch_.header.stamp;
+  }
+  const bool listening = applied_pub_.getNumSubscribers() > 0;
+  if (listening && !report_applied_) applied_batch_.since.fromSec(t);  // complete from the next step on
+  report_applied_ = listening;
+}
+
 void StageRos::run()
 {
   ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
@@ -284,6 +326,7 @@ void StageRos::run()
     }
     if (boundary_wait_pending_ && !waitForControllers()) continue;  // paused or shut down meanwhile
 
+    noteAppliedCommands();
     world_->step();  // calls the on*() listeners, which publish
     if (!tf_batch_.empty())
     {
@@ -307,6 +350,7 @@ void StageRos::run()
         next_clock_time_ = (std::floor((t + 1e-9) * params_.clock_rate) + 1.0) / params_.clock_rate;
     }
     if (params_.lockstep) noteBoundary();
+    publishAppliedCommands();
     // Markers are for eyes: at ~marker_rate in sim time, at most 30 Hz wall, only while someone listens.
     if (world_->time() + 1e-9 >= next_marker_time_ && ros::WallTime::now() >= next_marker_wall_ &&
         marker_pub_.getNumSubscribers() > 0)

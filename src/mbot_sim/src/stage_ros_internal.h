@@ -21,6 +21,9 @@ constexpr int kHoldingZeros = 3;
 /// beside move_base's goals.
 constexpr double kHoldingWallGap = 0.5;
 
+/// [s sim] /stage/applied_commands: one message per this much sim time, for all robots together.
+constexpr double kAppliedCommandsPeriod = 0.1;
+
 inline geometry_msgs::Quaternion yawToQuaternion(double yaw)
 {
   const std::array<double, 4> xyzw = mbot_common::quaternionFromYaw(yaw);

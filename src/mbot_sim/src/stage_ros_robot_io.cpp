@@ -188,6 +188,9 @@ void StageRos::onCmdVel(int robot, const geometry_msgs::Twist::ConstPtr& msg)
   io.last_cmd_wall = wall_now;
   io.cmd_boundary = boundary_count_;
   io.cmd_unused = true;
+  io.cmd_pending = true;  // a newer one replaces it: only the newest before a step is applied
+  io.cmd_received = world_->time();
+  io.cmd_msg = *msg;
 }
 
 /// As stage_ros: a pose in the map frame; z, roll and pitch are ignored. The robot is moved at

@@ -14,6 +14,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <mbot_msgs/AppliedCommands.h>
 #include <mbot_msgs/RemoveObstacle.h>
 #include <mbot_msgs/RemoveRobot.h>
 #include <mbot_msgs/SetFault.h>
@@ -118,6 +119,9 @@ private:
     ros::WallTime last_cmd_wall;        ///< lockstep: wall time of the last cmd_vel
     bool cmd_zero = false;              ///< lockstep: the last cmd_vel was all zeros (a stop)
     int zeros_at_rest = 0;              ///< lockstep: zero cmd_vels in a row that found the robot at rest
+    bool cmd_pending = false;           ///< /stage/applied_commands: a cmd_vel no step has used yet
+    double cmd_received = 0.0;          ///< ... the sim time it arrived [s]
+    geometry_msgs::Twist cmd_msg;       ///< ... as received
     double localization_stamp = -1e9;   ///< lockstep: newest stamp of a transform to <ns>/odom [s]
     bool localization_ignored = false;  ///< lockstep: its localization timed out; not waited for
                                         ///< until it has caught up
@@ -128,6 +132,8 @@ private:
   void publishRobotList();
   void publishMarkers();
   void publishClock();
+  void noteAppliedCommands();
+  void publishAppliedCommands();
   void noteBoundary();
   bool waitForControllers();
 
@@ -172,6 +178,11 @@ private:
   ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom and wheel transforms
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all transforms of one step
   double next_marker_time_ = 0.0;
+  // /stage/applied_commands (end-to-end control latency): every robot's cmd_vels as the steps used them
+  ros::Publisher applied_pub_;
+  bool report_applied_ = false;     ///< someone subscribes (checked at each publication)
+  double next_applied_time_ = 0.0;  ///< the next message when sim time reaches this [s]
+  mbot_msgs::AppliedCommands applied_batch_;
   double next_clock_time_ = 0.0;  ///< ~clock_rate: /clock when sim time reaches this
   ros::WallTime next_marker_wall_;
 
