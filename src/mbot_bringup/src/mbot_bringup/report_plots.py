@@ -359,9 +359,17 @@ def plot_latency(run, colors, path, limit):
     if limit is not None:
         ax.axvline(1000.0 * limit, color="#d62728", ls=":", lw=2,
                    label="limit %.0f ms (95th percentile)" % (1000.0 * limit))
-    ax.set_xlabel("control latency: pose stamp to the command acting [ms] (sim time)")
+    methods = [e.name for e in run.events if e.kind == "latency_method"]
+    labels = {"simulator": "the pose's age when the simulator applied the command [ms] (sim time)",
+              "pose_age": "the pose's age when the command was computed (no simulator report: without "
+                          "transport and actuation) [ms]",
+              "": "the pose's age when the command was computed + one physics step (recorded before the "
+                  "simulator's report) [ms]"}
+    ax.set_xlabel("control latency: " + labels.get(methods[-1] if methods else "", labels[""]))
     ax.set_ylabel("controller cycles [count]")
-    ax.set_title("Control latency of the followers (%d cycles)" % len(pooled))
+    dropped = sum(1 for c in run.controller if c.applied == 0.0)
+    ax.set_title("Control latency of the followers (%d cycles%s)"
+                 % (len(pooled), ", %d commands not applied" % dropped if dropped else ""))
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     return save(fig, path)

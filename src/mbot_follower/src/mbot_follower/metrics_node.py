@@ -13,8 +13,13 @@ every ``~write_period`` (5 s) and at shutdown, so that a killed run still leaves
 ``/lockstep/heartbeat`` (std_msgs/Header, stamp the newest sample's time), which the simulator
 waits for in lockstep, so that its sim time does not run ahead of what was measured.
 
-Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~physics_step`` 0.01 s added to every
-latency (the simulator applies a command at its next step), ``~recovered_rms`` 0.15 m and
+The control latency pairs each FollowerState with the simulator's report of when it applied that
+command, ``/stage/applied_commands`` (mbot_msgs/AppliedCommands); without that report (a real
+robot) it is the pose's age when the command was computed, logged once.
+
+Parameters (all times sim time): ``~rate`` 10 Hz samples, ``~command_wait`` 1 s (a command not
+applied this long after it was computed was not applied; no report this long: the fallback),
+``~recovered_rms`` 0.15 m and
 ``~recovered_hold`` 1 s (recovery after a loss), ``~robot_radius`` 0.15 m (clearance),
 ``~stale_after`` 1 s, ``~moving_speed`` 0.05 m/s, ``~teleport_speed`` 5 m/s, ``~hold_back`` 5 s,
 ``~slot_clearance`` 0.25 m, ``~free_hold`` 3 s and ``~controller_silence`` 0.5 s (see MetricsConfig).
@@ -25,7 +30,7 @@ import threading
 import time
 
 import rospy
-from mbot_msgs.msg import Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
+from mbot_msgs.msg import AppliedCommands, Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
 from nav_msgs.msg import OccupancyGrid, Odometry, Path
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
@@ -35,6 +40,7 @@ from mbot_common.params import read_params
 from mbot_follower.fleet_io import assignment_from_msg, quiet_at_shutdown
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.metrics import MetricsCollector, MetricsConfig, RunWriter, summarize
+from mbot_follower.metrics.collector import LATENCY_POSE_AGE
 from mbot_follower.metrics.obstacles import from_markers
 
 #: The live summary (/fleet/metrics, metrics.json while the run goes) goes over the whole record,
@@ -71,6 +77,11 @@ def read_config():
     return config, values
 
 
+def twist_values(twist):
+    """A Twist's six numbers, compared exactly: the simulator reports the cmd_vel as it arrived."""
+    return (twist.linear.x, twist.linear.y, twist.linear.z, twist.angular.x, twist.angular.y, twist.angular.z)
+
+
 def stamp_of(header):
     """The message's sim time [s]; the arrival time if it carries no stamp."""
     return header.stamp.to_sec() if not header.stamp.is_zero() else rospy.get_time()
@@ -102,7 +113,9 @@ class MetricsNode(object):
             rospy.Subscriber("/contacts", Contact, self.on_contact, queue_size=100),
             rospy.Subscriber("/map", OccupancyGrid, self.on_map, queue_size=1),
             rospy.Subscriber("/stage/markers", MarkerArray, self.on_markers, queue_size=5),
+            rospy.Subscriber("/stage/applied_commands", AppliedCommands, self.on_applied, queue_size=50),
         ]
+        self.latency_method = None   # logged when it changes
         for robot in robots:
             self.attach(robot)
 
@@ -186,7 +199,27 @@ class MetricsNode(object):
             if not self.closed:
                 self.collector.on_follower_state(robot, stamp_of(msg.header), msg.pose_stamp.to_sec(), msg.active,
                                                  msg.lookups, msg.lookup_failures, msg.cycle_time, msg.mode,
-                                                 msg.overruns, msg.late_starts)
+                                                 msg.overruns, msg.late_starts, twist_values(msg.cmd))
+                self._log_latency_method()
+
+    def on_applied(self, msg):
+        commands = [(c.robot, c.received.to_sec(), c.applied.to_sec(), twist_values(c.cmd)) for c in msg.commands]
+        with self.lock:
+            if not self.closed:
+                self.collector.on_applied_commands(msg.since.to_sec(), msg.header.stamp.to_sec(), commands)
+                self._log_latency_method()
+
+    def _log_latency_method(self):
+        method = self.collector.latency_method
+        if method == self.latency_method:
+            return
+        self.latency_method = method
+        if method == LATENCY_POSE_AGE:
+            rospy.logwarn("%s: no /stage/applied_commands (not a simulator?): control latency = the pose's age "
+                          "when the command was computed, without transport and actuation" % rospy.get_name())
+        else:
+            rospy.loginfo("%s: control latency measured end to end, from /stage/applied_commands"
+                          % rospy.get_name())
 
     def on_plan(self, msg, robot):
         if msg.poses and msg.header.frame_id.lstrip("/") != "map":
@@ -257,6 +290,7 @@ class MetricsNode(object):
             if self.closed:
                 return
             self.closed = True
+            self.collector.finish()   # the cycles still waiting for the simulator's report
             run = self.collector.run.snapshot()
         with self.write_lock:
             if self.writer is not None and self._write(run, summarize(run)):

@@ -38,9 +38,17 @@ What the numbers mean (all times sim time unless marked wall):
   leader lateral    distance of the leader from the polyline of its global plan (the newest one not
                     later than the leader's pose; a new goal, FORMING, forgets the old plans); the
                     summary counts it while the leader follows the plan (NAVIGATING, DEGRADED).
-  latency           FollowerState header.stamp (command computed) - pose_stamp (the tf pose it
-                    used) + one physics step (`physics_step`): the simulator applies a command at
-                    its next step. Only cycles that used a pose (active) count.
+  latency           end to end: the age of the pose a command was computed from (FollowerState
+                    pose_stamp) at the moment the simulator applied that command (the start of
+                    the first physics step that used it, from its report /stage/applied_commands).
+                    A cycle takes the first command of its robot applied at or after its stamp
+                    whose twist equals FollowerState.cmd exactly (a cycle replaced by an
+                    identical twist before a step shares that one's time); one not applied
+                    within command_wait (dropped, replaced before a step) has no latency and
+                    counts in commands_not_applied. Without the report (a real robot) it is the
+                    pose's age when the command was computed (header.stamp - pose_stamp); the
+                    `latency_method` event and the summary say which. Only cycles that used a
+                    pose (active) count.
   tf success rate   1 - lookup_failures / lookups, from the newest FollowerState of each robot.
   cycle time        the controller's computation time per cycle [ms wall], p99.
   clearance         robot-robot centre distance - 2 x robot_radius, over the samples.

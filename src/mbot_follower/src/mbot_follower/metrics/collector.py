@@ -28,6 +28,12 @@ def distance_to_polyline(x, y, points):
     return float(np.min(np.hypot(*(p - nearest).T)))
 
 
+#: latency methods (the `latency_method` event, the summary's latency_method)
+LATENCY_SIMULATOR = "simulator"   # when the simulator applied the command - the pose's stamp
+LATENCY_POSE_AGE = "pose_age"     # when the command was computed - the pose's stamp (no simulator report)
+_EPS = 1e-6   # [s] stamps pass through ROS time (whole nanoseconds)
+
+
 class MetricsCollector(object):
     """Builds a Run from message contents; every `on_*` takes the sim time t [s] of its message."""
 
@@ -60,6 +66,15 @@ class MetricsCollector(object):
         # change: a slot beside one is blocked as one beside a wall (on_obstacles).
         self.obstacles = {}
         self._obstacle_sets = []
+        # Control latency (on_follower_state, on_applied_commands): each robot's cycles wait here,
+        # oldest first, until the simulator's report says when their command was applied; a cycle
+        # becomes a ControllerSample (in order per robot) once that is known.
+        self.latency_method = None   # LATENCY_SIMULATOR or LATENCY_POSE_AGE; None: not known yet
+        self._cycles = {}            # robot -> [(ControllerSample, pose stamp or None, cmd tuple or None)]
+        self._applied = {}           # robot -> [(applied [s], cmd tuple)] of the report, oldest first
+        self._reported_until = None  # the report covers sim time up to here [s]; None: no report yet
+        self._unreported = []        # (from, to) [s]: spans the report did not cover
+        self._last_cycle = {}        # robot -> time of its newest cycle [s]
 
     def _know(self, robot):
         if robot not in self.distance:
@@ -161,15 +176,97 @@ class MetricsCollector(object):
         self.lost = lost
 
     def on_follower_state(self, robot, t, pose_stamp, active, lookups, lookup_failures, cycle_time, mode,
-                          overruns=0, late_starts=0):
+                          overruns=0, late_starts=0, cmd=None):
         """One follower controller cycle: t and pose_stamp [s sim], cycle_time [s wall], the
-        overrun counters so far. Its latency is t - pose_stamp + physics_step (the simulator
-        applies the command at its next step)."""
+        overrun counters so far, cmd the command it sent (any tuple of numbers, compared exactly
+        with the simulator's report: the twist's six fields). Its ControllerSample is recorded
+        when its latency is known (module docstring: latency)."""
         self._know(robot)
-        latency = t - pose_stamp + self.config.physics_step if active and pose_stamp > 0.0 else NAN
-        self.run.controller.append(ControllerSample(t, robot, latency, 1000.0 * cycle_time,
-                                                    int(lookups), int(lookup_failures), mode,
-                                                    int(overruns), int(late_starts)))
+        measured = active and pose_stamp > 0.0
+        row = ControllerSample(t, robot, NAN, 1000.0 * cycle_time, int(lookups), int(lookup_failures), mode,
+                               int(overruns), int(late_starts), NAN)
+        self._cycles.setdefault(robot, []).append((row, pose_stamp if measured else None,
+                                                   tuple(cmd) if cmd is not None else None))
+        self._last_cycle[robot] = max(t, self._last_cycle.get(robot, t))
+        self._resolve_cycles()
+
+    def on_applied_commands(self, since, until, commands):
+        """The simulator's report (/stage/applied_commands): every command applied in [since,
+        until) [s sim], as (robot, received, applied, cmd tuple), in the order applied."""
+        if self._reported_until is None:
+            self._unreported.append((-math.inf, since))
+        elif since > self._reported_until + _EPS:
+            self._unreported.append((self._reported_until, since))   # a pause of the report: unknown
+        self._reported_until = until if self._reported_until is None else max(until, self._reported_until)
+        for robot, _received, applied, cmd in commands:
+            self._applied.setdefault(robot, []).append((applied, tuple(cmd)))
+        if self.latency_method != LATENCY_SIMULATOR:
+            self._set_latency_method(until, LATENCY_SIMULATOR)
+        self._resolve_cycles()
+
+    def finish(self):
+        """At the end of a run: record every cycle still waiting; one whose command the report
+        has not shown yet gets a NaN latency, applied unknown."""
+        if self.latency_method is None and any(self._cycles.values()):
+            self._set_latency_method(max(self._last_cycle.values()), LATENCY_POSE_AGE)
+        self._resolve_cycles(final=True)
+
+    def _set_latency_method(self, t, method):
+        self.latency_method = method
+        detail = ("end to end: the simulator's report of when it applied each command (/stage/applied_commands)"
+                  if method == LATENCY_SIMULATOR else
+                  "no report of applied commands within command_wait (not a simulator): the pose's age when "
+                  "the command was computed, without transport and actuation")
+        self.run.events.append(Event(t, "latency_method", method, detail, NAN, NAN))
+
+    def _resolve_cycles(self, final=False):
+        """Record the waiting cycles whose latency is known now, in order per robot."""
+        wait = self.config.command_wait
+        if self.latency_method is None and self._last_cycle:
+            oldest = min((c[0][0].t for c in self._cycles.values() if c), default=None)
+            if oldest is not None and max(self._last_cycle.values()) - oldest >= wait:
+                self._set_latency_method(max(self._last_cycle.values()), LATENCY_POSE_AGE)
+        for robot, cycles in self._cycles.items():
+            done = 0
+            for row, pose_stamp, cmd in cycles:
+                result = self._latency(robot, row.t, pose_stamp, cmd, final)
+                if result is None:
+                    break
+                self.run.controller.append(row._replace(latency=result[0], applied=result[1]))
+                done += 1
+            del cycles[:done]
+            # Reports older than every cycle still to come cannot be theirs (a robot's cycles come
+            # in time order); for a robot without cycles (a leader on move_base) keep hold_back.
+            applied = self._applied.get(robot)
+            if applied:
+                floor = cycles[0][0].t if cycles else self._last_cycle.get(robot, -math.inf)
+                if not cycles and self._reported_until is not None:
+                    floor = max(floor, self._reported_until - self.config.hold_back)
+                k = 0
+                while k < len(applied) and applied[k][0] < floor - _EPS:
+                    k += 1
+                del applied[:k]
+
+    def _latency(self, robot, t, pose_stamp, cmd, final):
+        """(latency, applied) of a cycle at t, or None while not known yet (module docstring:
+        latency): the first command of the robot applied at or after t with exactly the twist sent."""
+        if pose_stamp is None:
+            return NAN, NAN
+        if self.latency_method == LATENCY_POSE_AGE:
+            return t - pose_stamp, NAN
+        if self.latency_method is None:
+            return (NAN, NAN) if final else None
+        for applied, twist in self._applied.get(robot, ()):
+            if applied >= t - _EPS and twist == cmd:
+                if applied <= t + self.config.command_wait + _EPS:
+                    return applied - pose_stamp, 1.0
+                break
+        if self._reported_until < t + self.config.command_wait - _EPS:
+            return (NAN, NAN) if final else None   # it may still come
+        end = t + self.config.command_wait
+        if any(start < end and t < stop for start, stop in self._unreported):
+            return NAN, NAN   # the report did not cover it
+        return NAN, 0.0
 
     def on_power(self, robot, t, power):
         """The energy model's rate [W] of a robot; it holds until the next one (at most stale_after)."""

@@ -16,7 +16,7 @@ ROBOT_COLUMNS = ["x_m", "y_m", "theta_rad", "slot_error_m", "fit_error_m", "dist
 OLD_ROBOT_COLUMNS = ROBOT_COLUMNS[:-1]
 EVENT_COLUMNS = ["t_s", "kind", "name", "detail", "x_m", "y_m"]
 CONTROLLER_COLUMNS = ["t_s", "robot", "latency_s", "cycle_time_ms", "lookups", "lookup_failures", "mode",
-                      "overruns", "late_starts"]
+                      "overruns", "late_starts", "applied"]
 FILES = ("metrics.csv", "events.csv", "controller.csv", "metrics.json")
 
 
@@ -172,13 +172,15 @@ def load_run(output_dir):
 
     path = os.path.join(output_dir, "controller.csv")
     header, rows = _read_csv(path)
-    if header not in (CONTROLLER_COLUMNS, CONTROLLER_COLUMNS[:7]):   # a run of before the overrun counters
+    # runs of before the overrun counters (7 columns) and before `applied` (9) read as well
+    if header not in (CONTROLLER_COLUMNS, CONTROLLER_COLUMNS[:7], CONTROLLER_COLUMNS[:9]):
         _read_csv(path, CONTROLLER_COLUMNS)   # raises, naming the expected columns
     for number, row in enumerate(rows, start=2):
         counters = [_int(path, number, "overruns", row[7]), _int(path, number, "late_starts", row[8])] \
             if len(row) > 7 else [0, 0]
+        applied = _float(path, number, "applied", row[9]) if len(row) > 9 else NAN
         run.controller.append(ControllerSample(
             _float(path, number, "t_s", row[0]), row[1], _float(path, number, "latency_s", row[2]),
             _float(path, number, "cycle_time_ms", row[3]), _int(path, number, "lookups", row[4]),
-            _int(path, number, "lookup_failures", row[5]), row[6], *counters))
+            _int(path, number, "lookup_failures", row[5]), row[6], *counters, applied))
     return run

@@ -22,25 +22,30 @@ Sample = namedtuple("Sample", "t state leader formation lost slot_rms slot_max f
 #:   state / new state / reason        assignment / formation / "leader L spacing S m [along_path] slots ..."
 #:   switch / new formation / old one  loss, rejoin / robot / ""
 #:   switch_done / formation / reason  pause / "start" or "end" / the coordinator's reason
+#:   latency_method / "simulator" or "pose_age" / why (how the control latency is measured from then on)
 #:   contact / body_a / body_b, at x, y [m] (NaN for the other kinds)
 Event = namedtuple("Event", "t kind name detail x y")
 
 #: One follower controller cycle: t [s] when the command was computed, latency [s] (NaN if the
-#: cycle used no pose), cycle_time_ms [ms wall], the controller's lookup counters, its mode, and
-#: its overrun counters so far: cycles that took longer than the period, cycles that started a
-#: period or more late.
+#: cycle used no pose or its command was not applied), cycle_time_ms [ms wall], the controller's
+#: lookup counters, its mode, its overrun counters so far (cycles that took longer than the
+#: period, cycles that started a period or more late), and applied: 1.0 the simulator applied its
+#: command, 0.0 it did not (dropped, or replaced before a physics step), NaN unknown (no pose, no
+#: simulator report: the latency is then the pose's age when the command was computed).
 ControllerSample = namedtuple("ControllerSample", "t robot latency cycle_time_ms lookups lookup_failures mode "
-                              "overruns late_starts", defaults=(0, 0))
+                              "overruns late_starts applied", defaults=(0, 0, NAN))
 
 
 class MetricsConfig(object):
     """Parameters of the metrics (the node reads them from its private parameters)."""
 
-    def __init__(self, rate=10.0, physics_step=0.01, recovered_rms=0.15, recovered_hold=1.0,
+    def __init__(self, rate=10.0, command_wait=1.0, recovered_rms=0.15, recovered_hold=1.0,
                  robot_radius=0.15, stale_after=1.0, moving_speed=0.05, teleport_speed=5.0, hold_back=5.0,
                  slot_clearance=0.25, free_hold=3.0, controller_silence=0.5, energy_k_v=4.0, energy_k_w=0.5):
         self.rate = rate                      # samples per sim second [Hz]
-        self.physics_step = physics_step      # added to every latency: a command acts at the next step [s]
+        # a command the simulator has not applied this long after it was computed was not applied;
+        # with no simulator report this long, the latency is the pose's age (a real robot) [s]
+        self.command_wait = command_wait
         self.recovered_rms = recovered_rms    # slot RMS under which the fleet has recovered from a loss [m]
         self.recovered_hold = recovered_hold  # ... and must stay under it this long [s]
         self.robot_radius = robot_radius      # clearance = centre distance - 2 radii [m]
@@ -58,7 +63,7 @@ class MetricsConfig(object):
 
     def check(self):
         """ValueError naming the first bad value (every value must be a finite number)."""
-        limits = [("rate", 0.0, False), ("physics_step", 0.0, True), ("recovered_rms", 0.0, False),
+        limits = [("rate", 0.0, False), ("command_wait", 0.0, False), ("recovered_rms", 0.0, False),
                   ("recovered_hold", 0.0, True), ("robot_radius", 0.0, True), ("stale_after", 0.0, False),
                   ("moving_speed", 0.0, True), ("teleport_speed", 0.0, False), ("hold_back", 0.0, True),
                   ("slot_clearance", 0.0, True), ("free_hold", 0.0, True), ("controller_silence", 0.0, False),
@@ -75,6 +80,7 @@ class MetricsConfig(object):
 
     @classmethod
     def from_dict(cls, values, where="metrics config"):
+        values = {k: v for k, v in values.items() if k != "physics_step"}   # runs of before command_wait
         unknown = sorted(set(values) - set(vars(cls())))
         if unknown:
             raise ValueError("%s: unknown key(s) %s (known: %s)"

@@ -53,6 +53,7 @@ def _controller_stats(rows):
     # beside the cycle time: how often a controller missed its period (newest counters per robot)
     out["cycle_overruns"] = sum(r.overruns for r in newest.values())
     out["cycle_late_starts"] = sum(r.late_starts for r in newest.values())
+    out["commands_not_applied"] = sum(1 for r in rows if r.applied == 0.0)   # dropped or replaced before a step
     return out
 
 
@@ -193,6 +194,8 @@ def summarize(run):
     lateral = [s.leader_lateral for s in run.samples if s.state in PLAN_STATES]
     fleet.update(_stats(lateral, "leader_lateral", "m", rms=True))
     fleet.update(_controller_stats(run.controller))
+    methods = [e.name for e in run.events if e.kind == "latency_method"]   # how latency was measured
+    fleet["latency_method"] = " then ".join(m for k, m in enumerate(methods) if k == 0 or m != methods[k - 1]) or None
     closest = None
     for s in run.samples:
         if math.isfinite(s.min_clearance) and (closest is None or s.min_clearance < closest.min_clearance):
