@@ -170,3 +170,38 @@ def test_every_robot_gets_power_and_energy_from_its_measured_velocity_whoever_co
     assert math.isclose(energy["leader"], power * 10.0, rel_tol=1e-3) and energy["robot_5"] == 0.0
     assert dict(zip(msg.robots, msg.robot_power)) == {"leader": power, "robot_5": 0.0}
     assert math.isclose(msg.energy, power * 10.0, rel_tol=1e-3)
+
+
+def test_the_simulators_report_gives_the_latency_and_finish_records_the_cycles_still_waiting(tmp_path, monkeypatch):
+    """FollowerState and AppliedCommands messages through the callbacks: a cycle's latency is the
+    pose's age when its command was applied; the method is logged once; at finish() the cycles
+    whose report never came are recorded (latency and applied unknown), none lost."""
+    from mbot_msgs.msg import AppliedCommand, AppliedCommands, FollowerState
+    import rospy
+
+    n = node(str(tmp_path))
+    n.latency_method = None
+    logged = []
+    monkeypatch.setattr(metrics_node.rospy, "loginfo", lambda *a: logged.append(a))
+    monkeypatch.setattr(metrics_node.rospy, "logwarn", lambda *a: logged.append(a))
+    report = AppliedCommands()
+    report.since, report.header.stamp = rospy.Time.from_sec(2.0), rospy.Time.from_sec(2.1)
+    for k in range(4):   # cycles at 2.0, 2.05, 2.1, 2.15: only the first two are in the report
+        t = 2.0 + 0.05 * k
+        msg = FollowerState(robot="robot_1", active=True, mode="slot")
+        msg.header.stamp, msg.pose_stamp = rospy.Time.from_sec(t), rospy.Time.from_sec(t - 0.03)
+        msg.cmd.linear.x, msg.cmd.angular.z = 0.1 * (k + 1), 0.2
+        n.on_state(msg, "robot_1")
+        if t + 0.02 < 2.1:
+            report.commands.append(AppliedCommand(robot="robot_1", received=msg.header.stamp,
+                                                  applied=rospy.Time.from_sec(t + 0.02), cmd=msg.cmd))
+    n.on_applied(report)
+    assert [round(c.latency, 6) for c in n.collector.run.controller] == [0.05, 0.05]   # ROS time: whole ns
+    n.finish()
+    rows = n.collector.run.controller
+    assert len(rows) == 4 and all(r != r for r in (rows[2].latency, rows[2].applied, rows[3].applied))
+    said = [a for a in logged if "latency" in a[0]]
+    assert len(said) == 1 and "/stage/applied_commands" in said[0][0]
+    with open(os.path.join(str(tmp_path), "metrics.json")) as f:
+        fleet = json.load(f)["fleet"]
+    assert fleet["latency_method"] == "simulator" and fleet["commands_not_applied"] == 0
