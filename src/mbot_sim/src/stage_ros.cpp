@@ -114,6 +114,8 @@ StageRos::StageRos(const ros::NodeHandle& nh, const StageParams& params) : nh_(n
   contact_pub_ = nh_.advertise<mbot_msgs::Contact>("contacts", 100);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("stage/markers", 1, true);
   applied_pub_ = nh_.advertise<mbot_msgs::AppliedCommands>("stage/applied_commands", 10);
+  fleet_truth_pub_ = nh_.advertise<mbot_msgs::RobotStates>("stage/ground_truth", 100);
+  fleet_truth_.header.frame_id = "map";
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);  // as tf2_ros::TransformBroadcaster
   for (int id : world_->robotIds()) addRobotIo(id);
   publishRobotList();
@@ -337,6 +339,15 @@ void StageRos::run()
       tf_batch_.reserve(tf->transforms.size());
       tf_pub_.publish(tf);
     }
+    // The fleet's ground truth in one message: a node watching every robot (metrics collector,
+    // scenario runner) takes one message per step instead of one per robot.
+    if (!fleet_truth_.robots.empty())
+    {
+      fleet_truth_.header.stamp = fleet_truth_.robots.front().stamp;
+      fleet_truth_pub_.publish(fleet_truth_);
+      fleet_truth_.robots.clear();
+    }
+    report_fleet_truth_ = fleet_truth_pub_.getNumSubscribers() > 0;
     // Every node wakes for each /clock message (rospy handles each in Python): ~clock_rate below the
     // physics rate spares the fleet's nodes that work. A lockstep boundary always gets its /clock:
     // the controllers' timers fire on it, and sim time waits there for their commands.

@@ -123,6 +123,15 @@ void StageRos::onGroundTruth(int robot, const GroundTruthSample& s)
   RobotIo& io = *io_[robot];
   fillOdometry(io.ground_truth_msg, s.stamp, s.pose, s.twist);
   io.ground_truth.publish(io.ground_truth_msg);
+  if (!report_fleet_truth_) return;
+  mbot_msgs::RobotState state;
+  state.name = io.name;
+  state.stamp = io.ground_truth_msg.header.stamp;
+  state.pose.x = s.pose.x;
+  state.pose.y = s.pose.y;
+  state.pose.theta = s.pose.theta;
+  state.twist = io.ground_truth_msg.twist.twist;
+  fleet_truth_.robots.push_back(state);
 }
 
 void StageRos::onJointState(int robot, const JointStateSample& s)

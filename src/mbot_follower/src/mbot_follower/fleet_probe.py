@@ -15,8 +15,7 @@ import time
 
 import rospy
 from geometry_msgs.msg import Pose2D as Pose2DMsg
-from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus, FollowerState
-from nav_msgs.msg import Odometry
+from mbot_msgs.msg import Contact, FleetAssignment, FleetStatus, FollowerState, RobotStates
 from std_msgs.msg import Header, String
 
 from mbot_common.geometry import Pose2D, yaw_of
@@ -78,7 +77,7 @@ class FleetProbe(object):
         self.assignment = None
         self.trail = LeaderTrail()   # the leader's ground truth since the assignment (path slots)
         self.contacts = []
-        self._truth_subs = {r: self._subscribe_truth(r) for r in robots}
+        self._truth_sub = self._subscribe_truth()
         rospy.Subscriber("/fleet/status", FleetStatus, self._on_status, queue_size=50)
         rospy.Subscriber("/fleet/assignment", FleetAssignment, self._on_assignment, queue_size=5)
         rospy.Subscriber("/contacts", Contact, self._on_contact, queue_size=100)
@@ -90,9 +89,11 @@ class FleetProbe(object):
         self._heartbeat_pub = rospy.Publisher("/lockstep/heartbeat", Header, queue_size=10) if pace else None
         self.timer = rospy.Timer(rospy.Duration(0.1), self._sample)
 
-    def _subscribe_truth(self, robot):
-        return rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self._on_truth, callback_args=robot,
-                                queue_size=5)
+    def _subscribe_truth(self):
+        # the whole fleet's ground truth in one message per step (stage_node's /stage/ground_truth),
+        # not one subscription per robot: rospy's cost is per message
+        return rospy.Subscriber("/stage/ground_truth", RobotStates, self._on_fleet_truth, queue_size=5,
+                                tcp_nodelay=True)
 
     def _subscribe_state(self, robot):
         return rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self._on_follower, queue_size=5)
@@ -101,12 +102,22 @@ class FleetProbe(object):
         self.modes[msg.robot] = msg.mode
         self.heartbeats[msg.robot] = msg.header.stamp.to_sec()
 
+    def _on_fleet_truth(self, msg):
+        for s in msg.robots:
+            if s.name in self._history:
+                self._truth(s.name, s.stamp.to_sec(), Pose2D(s.pose.x, s.pose.y, s.pose.theta),
+                            math.hypot(s.twist.linear.x, s.twist.linear.y))
+
     def _on_truth(self, msg, robot):
+        """One robot's nav_msgs/Odometry ground truth (its base_pose_ground_truth)."""
         p = msg.pose.pose
         v = msg.twist.twist.linear
+        self._truth(robot, msg.header.stamp.to_sec(), Pose2D(p.position.x, p.position.y, yaw_of(p.orientation)),
+                    math.hypot(v.x, v.y))
+
+    def _truth(self, robot, t, pose, speed):
         with self.lock:
-            pose = Pose2D(p.position.x, p.position.y, yaw_of(p.orientation))
-            self.truth[robot] = (msg.header.stamp.to_sec(), pose, math.hypot(v.x, v.y))
+            self.truth[robot] = (t, pose, speed)
             self._history[robot].append(self.truth[robot])
             if self.assignment is not None and robot == self.assignment.leader \
                     and self.truth[robot][0] > self.trail.since + 1e-9:
@@ -284,10 +295,10 @@ class FleetProbe(object):
             if time.time() > again:
                 # At load 50 one of five ground-truth subscriptions once never connected (rospy
                 # got the publisher twice at once): subscribe again to what is still silent.
+                if not self.truth:
+                    self._truth_sub.unregister()
+                    self._truth_sub = self._subscribe_truth()
                 for r in self.robots:
-                    if r not in self.truth:
-                        self._truth_subs[r].unregister()
-                        self._truth_subs[r] = self._subscribe_truth(r)
                     if r not in heard:  # (one connection per topic and process: renew both)
                         subs[r].unregister()
                         self._state_subs[r].unregister()

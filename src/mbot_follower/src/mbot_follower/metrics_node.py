@@ -2,10 +2,11 @@
 
 Inputs: ``/fleet/assignment`` (latched), ``/fleet/status``, ``/contacts``, ``/map`` (is a slot
 in a wall?), ``/stage/markers`` (the simulator's static obstacles, spawned ones too: a slot beside
-one is blocked as beside a wall; recorded as events) and per robot
-``/<ns>/base_pose_ground_truth`` (frame map), ``/<ns>/follower_controller/state``,
-and ``/<ns>/move_base/global_plan``. The robots are ``~robots`` if set, else every
-robot that appears in an assignment (subscribed when it first appears).
+one is blocked as beside a wall; recorded as events), the ground truth of every robot from
+``/stage/ground_truth`` (mbot_msgs/RobotStates, frame map: one message per step for the
+whole fleet; ``~ground_truth: robots`` takes each ``/<ns>/base_pose_ground_truth`` instead),
+and per robot ``/<ns>/follower_controller/state`` and ``/<ns>/move_base/global_plan``. The
+robots are ``~robots`` if set, else every robot that appears in an assignment (subscribed when it first appears).
 
 Outputs: ``/fleet/metrics`` (mbot_msgs/FleetMetrics, every ``~publish_period``, 1 s) and, when
 ``~output_dir`` is not empty, metrics.csv, events.csv, controller.csv and metrics.json in it,
@@ -30,7 +31,8 @@ import threading
 import time
 
 import rospy
-from mbot_msgs.msg import AppliedCommands, Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState
+from mbot_msgs.msg import (AppliedCommands, Contact, FleetAssignment, FleetMetrics, FleetStatus, FollowerState,
+                           RobotStates)
 from nav_msgs.msg import OccupancyGrid, Odometry, Path
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
@@ -55,7 +57,11 @@ NODE_PARAMS = {
     "output_dir": (str, ""),       # where the files go; empty: write nothing
     "publish_period": (float, 1.0),  # /fleet/metrics period [s]
     "write_period": (float, 5.0),    # files written this often [s]
+    # fleet: the simulator's /stage/ground_truth (every robot in one message per step); robots:
+    # each robot's /<robot>/base_pose_ground_truth (a simulator without the fleet topic)
+    "ground_truth": (str, "fleet"),
 }
+GROUND_TRUTH = ("fleet", "robots")
 
 
 def read_config():
@@ -71,6 +77,9 @@ def read_config():
     for key in ("publish_period", "write_period"):
         if not (math.isfinite(values[key]) and values[key] > 0.0):
             raise ValueError("%s: %s: expected a number > 0 [s], got %r" % (rospy.get_name(), key, values[key]))
+    if values["ground_truth"] not in GROUND_TRUTH:
+        raise ValueError("%s: ground_truth: expected one of %s, got %r" % (
+            rospy.get_name(), ", ".join(GROUND_TRUTH), values["ground_truth"]))
     for name in values["robots"]:
         if not isinstance(name, str) or not name or "/" in name:
             raise ValueError("%s: robots: expected robot names (no slashes), got %r" % (rospy.get_name(), name))
@@ -88,7 +97,7 @@ def stamp_of(header):
 
 
 class MetricsNode(object):
-    def __init__(self, config, robots, output_dir):
+    def __init__(self, config, robots, output_dir, ground_truth="fleet"):
         self.collector = MetricsCollector(config)
         self.writer = RunWriter(output_dir) if output_dir else None
         self.fixed_robots = bool(robots)
@@ -116,6 +125,10 @@ class MetricsNode(object):
             rospy.Subscriber("/stage/applied_commands", AppliedCommands, self.on_applied, queue_size=50),
         ]
         self.latency_method = None   # logged when it changes
+        self.fleet_truth = ground_truth == "fleet"
+        if self.fleet_truth:
+            self.shared_subs.append(rospy.Subscriber("/stage/ground_truth", RobotStates, self.on_fleet_truth,
+                                                     queue_size=200, tcp_nodelay=True))
         for robot in robots:
             self.attach(robot)
 
@@ -124,12 +137,13 @@ class MetricsNode(object):
             return
         rospy.loginfo("%s: measuring %s", rospy.get_name(), robot)
         self.subs[robot] = [
-            rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth, robot, queue_size=200,
-                             tcp_nodelay=True),
             rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, self.on_state, robot,
                              queue_size=100),
             rospy.Subscriber("/%s/move_base/global_plan" % robot, Path, self.on_plan, robot, queue_size=5),
         ]
+        if not self.fleet_truth:
+            self.subs[robot].append(rospy.Subscriber("/%s/base_pose_ground_truth" % robot, Odometry, self.on_truth,
+                                                     robot, queue_size=200, tcp_nodelay=True))
 
     # --- callbacks: convert the message, hand it to the collector ------------------------------
 
@@ -182,13 +196,29 @@ class MetricsNode(object):
             rospy.logerr_throttle(10.0, "%s: /%s/base_pose_ground_truth: %s; ignored"
                                   % (rospy.get_name(), robot, error))
             return
+        v = msg.twist.twist
+        self._poses([(robot, stamp_of(msg.header), p.position.x, p.position.y, theta,
+                      (v.linear.x, v.linear.y, v.angular.z))])
+
+    def on_fleet_truth(self, msg):
+        """/stage/ground_truth: the robots measured (attached) among them."""
+        if msg.header.frame_id.lstrip("/") != "map":
+            rospy.logerr_throttle(10.0, "%s: /stage/ground_truth: expected frame map, got %r; ignored"
+                                  % (rospy.get_name(), msg.header.frame_id))
+            return
+        self._poses([(s.name, s.stamp.to_sec(), s.pose.x, s.pose.y, s.pose.theta,
+                      (s.twist.linear.x, s.twist.linear.y, s.twist.angular.z))
+                     for s in msg.robots if s.name in self.subs])
+
+    def _poses(self, poses):
+        """Ground-truth poses [(robot, t, x, y, theta, twist)] to the collector; the heartbeat
+        when they completed a sample."""
         with self.lock:
             if self.closed:
                 return
             samples = len(self.collector.run.samples)
-            v = msg.twist.twist
-            self.collector.on_pose(robot, stamp_of(msg.header), p.position.x, p.position.y, theta,
-                                   (v.linear.x, v.linear.y, v.angular.z))
+            for pose in poses:
+                self.collector.on_pose(*pose)
             if len(self.collector.run.samples) == samples:
                 return
             self.heartbeat.stamp = rospy.Time.from_sec(self.collector.run.samples[-1].t)
@@ -314,7 +344,7 @@ def main():
     rospy.init_node("metrics_collector")
     try:
         config, params = read_config()
-        node = MetricsNode(config, params["robots"], params["output_dir"])
+        node = MetricsNode(config, params["robots"], params["output_dir"], params["ground_truth"])
     except (ValueError, OSError) as error:   # ConfigError is a ValueError
         rospy.logfatal(str(error))
         return 1

@@ -47,7 +47,7 @@ class FakeRospy(object):
         self.stuck = stuck
         self.made = collections.Counter()
 
-    def subscriber(self, topic, kind, callback, callback_args=None, queue_size=None):
+    def subscriber(self, topic, kind, callback, callback_args=None, queue_size=None, tcp_nodelay=False):
         from unittest import mock
         self.made[topic] += 1
         if self.made[topic] <= self.stuck.get(topic, 0):
@@ -56,6 +56,9 @@ class FakeRospy(object):
         msg.header.stamp = rospy.Time(1.0)
         if hasattr(msg, "pose"):
             msg.pose.pose.orientation.w = 1.0
+        if hasattr(msg, "robots"):   # the fleet's ground truth: robots a and b
+            from mbot_msgs.msg import RobotState
+            msg.robots = [RobotState(name=r, stamp=rospy.Time(1.0)) for r in ("a", "b")]
         if callback_args is None:
             callback(msg)
         else:
@@ -69,8 +72,8 @@ def test_wait_for_fleet_subscribes_again_to_what_stays_silent(monkeypatch):
     import mbot_follower.fleet_probe as fp
     import mbot_navigation.move_base_client as mbc
 
-    # b's ground truth, and b's controller state for the probe's and the wait's own subscriber
-    fake = FakeRospy(stuck={"/b/base_pose_ground_truth": 1, "/b/follower_controller/state": 2})
+    # the fleet's ground truth, and b's controller state for the probe's and the wait's own subscriber
+    fake = FakeRospy(stuck={"/stage/ground_truth": 1, "/b/follower_controller/state": 2})
     monkeypatch.setattr(rospy, "Subscriber", fake.subscriber)
     monkeypatch.setattr(rospy, "Publisher", mock.Mock())
     monkeypatch.setattr(rospy, "Timer", mock.Mock())
@@ -78,8 +81,8 @@ def test_wait_for_fleet_subscribes_again_to_what_stays_silent(monkeypatch):
     monkeypatch.setattr(mbc, "connect_move_base", lambda robot, timeout: None)
     monkeypatch.setattr(fp, "RESUBSCRIBE_AFTER", 0.2)
     probe = fp.FleetProbe(["a", "b"])
-    assert sorted(probe.truth) == ["a"]
+    assert sorted(probe.truth) == []
     probe.wait_for_fleet(wall_timeout=5.0)
     assert sorted(probe.truth) == ["a", "b"]
-    assert fake.made["/b/base_pose_ground_truth"] == 2 and fake.made["/a/base_pose_ground_truth"] == 1
+    assert fake.made["/stage/ground_truth"] == 2 and not fake.made["/a/base_pose_ground_truth"]
     assert fake.made["/b/follower_controller/state"] == 4 and fake.made["/a/follower_controller/state"] == 2

@@ -205,3 +205,54 @@ def test_the_simulators_report_gives_the_latency_and_finish_records_the_cycles_s
     with open(os.path.join(str(tmp_path), "metrics.json")) as f:
         fleet = json.load(f)["fleet"]
     assert fleet["latency_method"] == "simulator" and fleet["commands_not_applied"] == 0
+
+
+def test_the_fleets_ground_truth_in_one_message_measures_as_each_robots_own_topic(tmp_path, monkeypatch):
+    """/stage/ground_truth (one RobotStates per step) and /<robot>/base_pose_ground_truth give the
+    collector the same poses, distances and energy; a robot not measured is left out."""
+    import rospy
+    from mbot_msgs.msg import RobotState, RobotStates
+
+    def fresh():
+        n = metrics_node.MetricsNode.__new__(metrics_node.MetricsNode)
+        n.collector = MetricsCollector()
+        n.lock = threading.Lock()
+        n.closed = False
+        n.heartbeat_pub = Publisher()
+        n.heartbeat = metrics_node.Header()
+        n.subs = {"leader": [], "robot_5": []}
+        return n
+
+    monkeypatch.setattr(rospy.Time, "now", staticmethod(lambda: rospy.Time.from_sec(10.0)))
+    one, each = fresh(), fresh()
+    for k in range(101):
+        t = 1.0 + k * 0.1
+        own = {"leader": truth(t, 0.03 * k, 0.3, 0.2), "robot_5": truth(t, 4.0, 0.0), "robot_9": truth(t, 9.0, 0.0)}
+        fleet = RobotStates()
+        fleet.header.frame_id = "map"
+        for name, msg in sorted(own.items()):
+            p, v = msg.pose.pose, msg.twist.twist
+            state = RobotState(name=name, stamp=msg.header.stamp)
+            state.pose.x, state.pose.y = p.position.x, p.position.y
+            state.pose.theta = metrics_node.yaw_of(p.orientation)
+            state.twist = v
+            fleet.robots.append(state)
+        one.on_fleet_truth(fleet)
+        for name in ("leader", "robot_5"):
+            each.on_truth(own[name], name)
+    assert set(one.collector.poses) == {"leader", "robot_5"}
+    assert one.collector.poses == each.collector.poses
+    assert one.collector.distance == each.collector.distance and one.collector.energy == each.collector.energy
+    assert one.collector.distance["leader"] > 2.5
+    assert [s.t for s in one.collector.run.samples] == [s.t for s in each.collector.run.samples]
+    assert one.heartbeat_pub.sent and len(one.heartbeat_pub.sent) <= len(each.heartbeat_pub.sent)
+
+
+def test_an_unknown_ground_truth_source_is_refused_by_name(monkeypatch):
+    import pytest
+    import rospy
+
+    monkeypatch.setattr(rospy, "get_param", lambda key, default=None: {"ground_truth": "odom"})
+    monkeypatch.setattr(rospy, "get_name", lambda: "/metrics_collector")
+    with pytest.raises(ValueError, match="ground_truth: expected one of fleet, robots, got 'odom'"):
+        metrics_node.read_config()

@@ -15,6 +15,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <mbot_msgs/AppliedCommands.h>
+#include <mbot_msgs/RobotStates.h>
 #include <mbot_msgs/RemoveObstacle.h>
 #include <mbot_msgs/RemoveRobot.h>
 #include <mbot_msgs/SetFault.h>
@@ -177,6 +178,10 @@ private:
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_server_;
   ros::Publisher tf_pub_;                                  ///< /tf: the robots' odom and wheel transforms
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all transforms of one step
+  // /stage/ground_truth: every robot's ground truth of one step in one message, while subscribed
+  ros::Publisher fleet_truth_pub_;
+  bool report_fleet_truth_ = false;      ///< someone subscribes (checked after each step)
+  mbot_msgs::RobotStates fleet_truth_;  ///< this step's ground truth samples
   double next_marker_time_ = 0.0;
   // /stage/applied_commands (end-to-end control latency): every robot's cmd_vels as the steps used them
   ros::Publisher applied_pub_;
