@@ -39,12 +39,13 @@ PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& option
   return result;
 }
 
-std::vector<std::string> plannerNames() { return {"pp", "lacam", "auto"}; }
+std::vector<std::string> plannerNames() { return {"pp", "lacam", "ecbs", "auto"}; }
 
 std::unique_ptr<Planner> makePlanner(const std::string& name)
 {
   if (name == "pp") return std::make_unique<PrioritizedPlanner>();
   if (name == "lacam") return std::make_unique<LacamPlanner>();
+  if (name == "ecbs") return std::make_unique<EcbsPlanner>();
   if (name == "auto") return std::make_unique<AutoPlanner>();
   std::string known;
   for (const auto& n : plannerNames()) known += (known.empty() ? "" : ", ") + n;

@@ -1,6 +1,7 @@
 // One interface for the MAPF algorithms, picked by name (the live planner's parameter):
 //   "pp"     prioritized planning with SIPP per agent, re-prioritised restarts (fast, incomplete)
 //   "lacam"  LaCAM (complete: finds a solution when one exists, given the time)
+//   "ecbs"   ECBS (bounded suboptimal: sum of costs <= w * optimum, with the proof in lower_bound)
 //   "auto"   pp for part of the time limit, then lacam when pp could not solve it; then the
 //            solution is improved by large neighbourhood search for up to refine_s
 #pragma once
@@ -21,6 +22,8 @@ struct PlannerOptions
   double pp_share = 0.25;
   // auto: time spent improving the first solution (LNS), within the time limit; 0: none
   double refine_s = 0.5;
+  // ecbs: the suboptimality bound (>= 1; 1 is optimal CBS)
+  double w = 1.05;
 };
 
 struct PlanResult
@@ -34,6 +37,8 @@ struct PlanResult
   double first_solution_s = 0.0;  // time to the first solution (auto: before the LNS)
   long first_sum_of_costs = 0;    // its sum of costs
   long lns_iterations = 0;
+  // ecbs: a proven lower bound on the optimal sum of costs (sum of costs / lower_bound <= w); 0: none
+  long lower_bound = 0;
 };
 
 class Planner
@@ -62,6 +67,15 @@ class LacamPlanner : public Planner
 public:
   PlanResult solve(const Instance& instance, const PlannerOptions& options) override;
   std::string name() const override { return "lacam"; }
+};
+
+// ECBS (Barer et al. 2014): conflict-based search, focal search on both levels (fewest conflicts
+// first within w of the lower bound). Sum of costs <= w * LB <= w * optimum; LB in lower_bound.
+class EcbsPlanner : public Planner
+{
+public:
+  PlanResult solve(const Instance& instance, const PlannerOptions& options) override;
+  std::string name() const override { return "ecbs"; }
 };
 
 // pp for options.pp_share of the time limit, then lacam for the rest; then LNS (lns.h) for up to
