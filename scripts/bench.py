@@ -24,12 +24,13 @@
                                       same robots with a move_base goal each
                                       (mbot_bringup/fleet_bench.py)
     scripts/bench mapf [--json FILE] [--maps empty-32-32,...] [--time-limit S] [--max-agents K]
-                      [--algorithm auto|pp|lacam]
+                      [--algorithm auto|pp|lacam|ecbs] [--w W] [--agents 50,100]
                                       multi-agent path finding on the MovingAI instances
                                       (mbot_coordination/bench/mapf), the EECBS protocol: each map,
                                       scenarios 1..5, k = 10, 20, 30, ... agents until fewer than
                                       half of the five are solved, 60 s per instance by default;
                                       success, runtime p50 and sum of costs over the lower bound
+                                      (ecbs: also over its proven bound; --agents: only these k)
     scripts/bench all [--json FILE]   sim and nav (the formation and fleet benchmarks take long: run them alone)
 
 Each benchmark is a C++ program built with the workspace (Release); it prints one JSON object.
@@ -197,11 +198,11 @@ def bench_fleet(sizes, modes):
                                    modes.split(","))
 
 
-def run_mapf(map_name, scen, agents, time_limit, algorithm):
+def run_mapf(map_name, scen, agents, time_limit, algorithm, w):
     """One mapf_bench instance on one core; its JSON (success false is a result, not an error)."""
     cmd = [program("mbot_coordination", "mapf_bench"), "--map", os.path.join(MAPF_INPUTS, map_name + ".map"),
            "--scen", os.path.join(MAPF_INPUTS, "%s-random-%d.scen" % (map_name, scen)), "--agents", str(agents),
-           "--time-limit", str(time_limit), "--algorithm", algorithm, "--json", "-"]
+           "--time-limit", str(time_limit), "--algorithm", algorithm, "--w", str(w), "--json", "-"]
     full = ["taskset", "-c", "0"] + cmd if shutil.which("taskset") else cmd
     out = subprocess.run(full, stdout=subprocess.PIPE, universal_newlines=True)
     if out.returncode not in (0, 1):  # 2: bad input, 3: an invalid solution (a planner bug)
@@ -209,19 +210,21 @@ def run_mapf(map_name, scen, agents, time_limit, algorithm):
     return json.loads([line for line in out.stdout.splitlines() if line.startswith("{")][-1])
 
 
-def bench_mapf(maps, time_limit, max_agents, algorithm):
-    """The EECBS protocol: per map, k = 10, 20, ... on scenarios 1..5 until fewer than half are solved.
-    runtime_p50_s counts an unsolved run as the time limit; soc_ratio is the mean over solved runs of
-    sum of costs / lower bound (each agent's own 4-connected shortest path)."""
+def bench_mapf(maps, time_limit, max_agents, algorithm, w=1.05, agents=None):
+    """The EECBS protocol: per map, k = 10, 20, ... on scenarios 1..5 until fewer than half are solved
+    (agents: exactly these k instead). runtime_p50_s counts an unsolved run as the time limit; soc_ratio
+    is the mean over solved runs of sum of costs / lower bound (each agent's own 4-connected shortest
+    path); proven_ratio (ecbs) the same over the planner's proven lower bound, a certificate (<= w)."""
     table = {}
     runs = {}
     for map_name in maps:
         table[map_name] = {}
-        k = 10
+        ks = list(agents) if agents else None
+        k = ks.pop(0) if ks else 10
         while max_agents is None or k <= max_agents:
             results = []
             for scen in range(1, 6):
-                r = run_mapf(map_name, scen, k, time_limit, algorithm)
+                r = run_mapf(map_name, scen, k, time_limit, algorithm, w)
                 print("  %s k=%d scen %d: %s %.3f s" % (map_name, k, scen, "solved" if r["success"] else "failed",
                                                         r["runtime_s"]), file=sys.stderr)
                 results.append(r)
@@ -234,13 +237,23 @@ def bench_mapf(maps, time_limit, max_agents, algorithm):
                 row["first_solution_p50_s"] = round(median([r["first_solution_s"] for r in solved]), 4)
                 row["first_soc_ratio"] = round(sum(r["first_sum_of_costs"] / r["lower_bound"] for r in solved)
                                                / len(solved), 4)
+                proven = [r for r in solved if r.get("proven_lower_bound")]
+                if proven:
+                    row["proven_ratio"] = round(sum(r["sum_of_costs"] / r["proven_lower_bound"] for r in proven)
+                                                / len(proven), 4)
+                    row["proven_ratio_max"] = round(max(r["sum_of_costs"] / r["proven_lower_bound"] for r in proven), 4)
             table[map_name][str(k)] = row
             runs["%s/%d" % (map_name, k)] = results
+            if agents:
+                if not ks:
+                    break
+                k = ks.pop(0)
+                continue
             if 2 * len(solved) < len(results):
                 break
             k += 10
-    return {"mapf": table, "mapf_settings": {"time_limit_s": time_limit, "algorithm": algorithm,
-                                             "max_agents": max_agents}, "mapf_runs": runs}
+    return {"mapf": table, "mapf_settings": {"time_limit_s": time_limit, "algorithm": algorithm, "w": w,
+                                             "agents": agents, "max_agents": max_agents}, "mapf_runs": runs}
 
 
 def print_table(result):
@@ -286,18 +299,22 @@ def print_table(result):
                 f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
     if "mapf" in result:
         st = result["mapf_settings"]
+        name = st["algorithm"] + (" w=%g" % st["w"] if st["algorithm"] == "ecbs" else "")
         print("\nMAPF (MovingAI instances, scenarios 1-5, %s, %g s limit; ratio = sum of costs / sum of the"
-              " agents' own 4-connected shortest paths, mean over solved runs)" % (st["algorithm"], st["time_limit_s"]))
-        print("  %-24s %6s %8s %12s %14s %10s %10s" % (
-            "map", "agents", "solved", "runtime p50", "first sol. p50", "ratio", "first"))
+              " agents' own 4-connected shortest paths, mean over solved runs; proven = sum of costs / the"
+              " planner's proven lower bound, mean and max)" % (name, st["time_limit_s"]))
+        print("  %-24s %6s %8s %12s %14s %10s %10s %14s" % (
+            "map", "agents", "solved", "runtime p50", "first sol. p50", "ratio", "first", "proven"))
 
         def g(row, key, fmt):
             return fmt % row[key] if key in row else "-"
         for map_name, rows in result["mapf"].items():
             for k, r in rows.items():
-                print("  %-24s %6s %8s %12s %14s %10s %10s" % (
+                proven = ("%.3f / %.3f" % (r["proven_ratio"], r["proven_ratio_max"])) if "proven_ratio" in r else "-"
+                print("  %-24s %6s %8s %12s %14s %10s %10s %14s" % (
                     map_name, k, "%d/%d" % (r["solved"], r["runs"]), "%.3f s" % r["runtime_p50_s"],
-                    g(r, "first_solution_p50_s", "%.3f s"), g(r, "soc_ratio", "%.3f"), g(r, "first_soc_ratio", "%.3f")))
+                    g(r, "first_solution_p50_s", "%.3f s"), g(r, "soc_ratio", "%.3f"), g(r, "first_soc_ratio", "%.3f"),
+                    proven))
     if "trial" in result:
         t = result["trial"]
         print("\nNavigation trial (office, real_time_factor %g): %d of %d goals reached, %d contacts, "
@@ -327,7 +344,10 @@ def main(argv=None):
     parser.add_argument("--maps", default=",".join(MAPF_MAPS), help="mapf: map names (default: all five)")
     parser.add_argument("--time-limit", type=float, default=60.0, help="mapf: seconds per instance (default 60)")
     parser.add_argument("--max-agents", type=int, help="mapf: stop each map at this many agents")
-    parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp or lacam (default auto)")
+    parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp, lacam or ecbs (default auto)")
+    parser.add_argument("--w", type=float, default=1.05, help="mapf: ecbs's suboptimality bound (default 1.05)")
+    parser.add_argument("--agents", help="mapf: only these agent counts, e.g. 50,100 (default: 10, 20, ... as the"
+                        " protocol says)")
     args = parser.parse_args(argv)
     if args.sim_runs < 1:
         parser.error("--sim-runs must be >= 1")
@@ -351,7 +371,17 @@ def main(argv=None):
             parser.error("--time-limit must be > 0")
         if args.max_agents is not None and args.max_agents < 10:
             parser.error("--max-agents must be >= 10")
-        result.update(bench_mapf(maps, args.time_limit, args.max_agents, args.algorithm))
+        if args.algorithm not in ("auto", "pp", "lacam", "ecbs"):
+            parser.error("--algorithm: auto, pp, lacam or ecbs")
+        if not args.w >= 1.0:
+            parser.error("--w must be >= 1")
+        try:
+            agents = [int(k) for k in args.agents.split(",")] if args.agents else None
+        except ValueError:
+            parser.error("--agents: comma-separated whole numbers, e.g. 50,100")
+        if agents and min(agents) < 1:
+            parser.error("--agents must be >= 1")
+        result.update(bench_mapf(maps, args.time_limit, args.max_agents, args.algorithm, args.w, agents))
     result["machine"] = machine()
     print_table(result)
     if args.json:

@@ -1,9 +1,10 @@
 // mapf_bench: one MAPF instance (a MovingAI map, the first K rows of a scenario) solved by the
 // planner the live coordinator uses; prints success, sum of costs, makespan, runtime and the lower
 // bounds, and checks every solution it reports with the validator.
-//   mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|auto]
-//              [--seed N] [--refine S] [--json FILE|-]
+//   mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|auto]
+//              [--seed N] [--refine S] [--w W] [--json FILE|-]
 // --refine: auto's time for improving its first solution (LNS), default 0.5 s
+// --w: ecbs's suboptimality bound (default 1.05); ecbs also reports its proven lower bound
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -21,8 +22,8 @@ namespace
 [[noreturn]] void usage(const std::string& problem)
 {
   std::cerr << "mapf_bench: " << problem << "\n"
-            << "usage: mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|auto]"
-               " [--seed N] [--refine S] [--json FILE|-]\n";
+            << "usage: mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|auto]"
+               " [--seed N] [--refine S] [--w W] [--json FILE|-]\n";
   std::exit(2);
 }
 
@@ -55,6 +56,7 @@ int main(int argc, char** argv)
   double time_limit = -1.0;
   unsigned seed = 0;
   double refine = PlannerOptions().refine_s;
+  double w = PlannerOptions().w;
   for (int k = 1; k < argc; ++k)
   {
     const std::string a = argv[k];
@@ -75,6 +77,8 @@ int main(int argc, char** argv)
       seed = static_cast<unsigned>(number(a, v));
     else if (a == "--refine")
       refine = number(a, v);
+    else if (a == "--w")
+      w = number(a, v);
     else if (a == "--json")
       json_path = v;
     else
@@ -84,6 +88,7 @@ int main(int argc, char** argv)
   if (agents < 1) usage("--agents must be >= 1");
   if (!(time_limit > 0.0)) usage("--time-limit must be > 0 seconds");
   if (!(refine >= 0.0)) usage("--refine must be >= 0 seconds");
+  if (!(w >= 1.0)) usage("--w must be >= 1");
 
   PlanResult result;
   Instance inst;
@@ -105,6 +110,7 @@ int main(int argc, char** argv)
     options.time_limit_s = time_limit;
     options.seed = seed;
     options.refine_s = refine;
+    options.w = w;
     result = planner->solve(inst, options);
     if (result.solved) invalid = validate(inst, result.paths);
   }
@@ -127,6 +133,7 @@ int main(int argc, char** argv)
          << ", \"first_solution_s\": " << result.first_solution_s
          << ", \"first_sum_of_costs\": " << result.first_sum_of_costs
          << ", \"lns_iterations\": " << result.lns_iterations;
+  if (ok && result.lower_bound > 0) json << ", \"w\": " << w << ", \"proven_lower_bound\": " << result.lower_bound;
   json << ", \"lower_bound\": " << lower_bound << ", \"scen_optimal_sum\": " << scen_bound
        << ", \"attempts\": " << result.attempts
        << ", \"message\": " << quoted(invalid.empty() ? result.message : invalid) << "}";
@@ -139,6 +146,9 @@ int main(int argc, char** argv)
   if (ok)
   {
     std::printf("sum of costs:  %ld (%.2f %% over the lower bound)\n", soc, 100.0 * (soc - lower_bound) / lower_bound);
+    if (result.lower_bound > 0)
+      std::printf("proven bound:  %ld (the optimum is >= this: sum of costs / bound = %.4f <= w = %g)\n",
+                  result.lower_bound, static_cast<double>(soc) / result.lower_bound, w);
     std::printf("makespan:      %d\n", span);
     std::printf("first solution: %.4f s, sum of costs %ld (then %ld LNS iterations)\n", result.first_solution_s,
                 result.first_sum_of_costs, result.lns_iterations);
