@@ -63,6 +63,7 @@ def path_length_table(free, resolution, origin_xy, robots, goals):
 
 
 POLICIES = ("hungarian", "round_robin")
+LOOK_AHEAD = 10   # goals beyond one per free robot whose costs are asked for, for those no free robot reaches
 
 
 def best_pairs(table):
@@ -127,11 +128,16 @@ class DispatchQueue(object):
         reach (or that they failed) waits for the others and does not hold up the goals behind
         it; when every robot is free and none can reach it, it is dropped (see `dropped`)."""
         free = [r for r in free if r not in self.active]
+        if not free or not self.pending:
+            return []
+        # one table for the oldest goals (a planner's cost is per robot: one search serves all goals)
+        candidates = self.pending[:len(free) + LOOK_AHEAD]
+        full = np.asarray(costs(free, candidates), dtype=float).reshape(len(free), len(candidates))
         window, columns = [], []
-        for goal in list(self.pending):
+        for j, goal in enumerate(candidates):
             if len(window) == len(free):
                 break
-            column = np.asarray(costs(free, [goal]), dtype=float).reshape(len(free))
+            column = full[:, j].copy()
             column[[r in goal.failed_by for r in free]] = np.inf
             if np.isfinite(column).any():
                 window.append(goal)

@@ -9,10 +9,11 @@ it is free; ``/dispatch/assignment`` (std_msgs/String, latched: a line per robot
 "robot_2 -> goal 3 (3.00, 4.50) 7.35 m", then the goals waiting).
 
 Parameters: ``~world`` (the run's world file: robots and map), ``~policy`` (hungarian,
-round_robin), ``~cost`` (plan: the length of the plan of the robot's own move_base
-``make_plan`` service, from where it stands; grid: the shortest way through the world's map),
-``~stuck_timeout`` (30 s sim: a robot that has not moved 0.1 m for so long, or whose pose is
-lost, has its goal cancelled and given to another robot).
+round_robin), ``~cost`` (grid, default: the shortest way through the world's map; plan: the length of the
+plan of the robot's own move_base ``make_plan`` service from where it stands, with its teammates
+where they stand now),
+``~stuck_timeout`` (30 s sim: a robot that has not moved 0.1 m for so long, unless it is within
+0.5 m of its goal, or whose pose is lost, has its goal cancelled and given to another robot).
 """
 import functools
 import math
@@ -30,6 +31,7 @@ from mbot_bringup.dispatch import DispatchConfig, DispatchError, DispatchQueue, 
 MAX_POSE_AGE = 1.0   # [s sim] an older robot pose does not count: that robot gets no goal
 COSTS = ("plan", "grid")
 PROGRESS = 0.1       # [m] a robot that moved less than this is not progressing
+NEAR_GOAL = 0.5      # [m] ... unless it is this close to its goal: it is finishing (turning, settling)
 SUCCEEDED = 3        # actionlib GoalStatus
 
 
@@ -42,7 +44,7 @@ def plan_length(poses):
 
 
 class DispatcherNode(object):
-    def __init__(self, world_file, policy="hungarian", cost="plan", stuck_timeout=30.0):
+    def __init__(self, world_file, policy="hungarian", cost="grid", stuck_timeout=30.0):
         import actionlib
         import tf2_ros
         from geometry_msgs.msg import PoseArray
@@ -213,6 +215,8 @@ class DispatcherNode(object):
                     continue
                 if now - since < self.stuck_timeout:
                     continue
+                if here is not None and math.dist(here, (goal.x, goal.y)) < NEAR_GOAL:
+                    continue   # at its goal, move_base still finishing: giving the goal away would be worse
                 why = "lost (no pose)" if here is None else "stuck (moved < %.1f m)" % PROGRESS
                 rospy.logwarn("dispatcher: %s %s for %.0f s: %r goes to another robot", robot, why, now - since, goal)
                 self.clients[robot].cancel_goal()
@@ -231,7 +235,7 @@ def main():
         rospy.logfatal("dispatcher: set ~world (the world file of the run)")
         raise SystemExit(1)
     try:
-        DispatcherNode(world_file, rospy.get_param("~policy", "hungarian"), rospy.get_param("~cost", "plan"),
+        DispatcherNode(world_file, rospy.get_param("~policy", "hungarian"), rospy.get_param("~cost", "grid"),
                        float(rospy.get_param("~stuck_timeout", 30.0)))
     except DispatchError as error:
         rospy.logfatal("dispatcher: %s", error)
