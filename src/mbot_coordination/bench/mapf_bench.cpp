@@ -1,10 +1,10 @@
 // mapf_bench: one MAPF instance (a MovingAI map, the first K rows of a scenario) solved by the
 // planner the live coordinator uses; prints success, sum of costs, makespan, runtime and the lower
 // bounds, and checks every solution it reports with the validator.
-//   mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|auto]
+//   mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|eecbs|auto]
 //              [--seed N] [--refine S] [--w W] [--json FILE|-]
 // --refine: auto's time for improving its first solution (LNS), default 0.5 s
-// --w: ecbs's suboptimality bound (default 1.05); ecbs also reports its proven lower bound
+// --w: ecbs's and eecbs's suboptimality bound (default 1.05); they also report its proven lower bound
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -21,9 +21,10 @@ namespace
 {
 [[noreturn]] void usage(const std::string& problem)
 {
-  std::cerr << "mapf_bench: " << problem << "\n"
-            << "usage: mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|auto]"
-               " [--seed N] [--refine S] [--w W] [--json FILE|-]\n";
+  std::cerr
+      << "mapf_bench: " << problem << "\n"
+      << "usage: mapf_bench --map FILE --scen FILE --agents K --time-limit S [--algorithm pp|lacam|ecbs|eecbs|auto]"
+         " [--seed N] [--refine S] [--w W] [--json FILE|-]\n";
   std::exit(2);
 }
 

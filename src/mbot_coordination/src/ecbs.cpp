@@ -250,9 +250,11 @@ AgentConstraints constraintsOf(const CtNode* node, int agent, int goal, int64_t 
 }
 }  // namespace
 
-PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& options)
+PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& given)
 {
   checkInstance(inst);
+  PlannerOptions options = given;
+  if (eecbs_) options.ecbs_bypass = options.ecbs_explicit_estimation = true;
   if (!(options.w >= 1.0) || !std::isfinite(options.w))
     throw std::invalid_argument("ecbs: suboptimality bound w must be >= 1, got " + std::to_string(options.w));
   const auto t0 = Clock::now();
@@ -266,7 +268,7 @@ PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& option
   for (int i = 0; i < n; ++i) h[i] = grid.distancesTo(inst.goals[i]);
 
   PlanResult result;
-  result.algorithm = "ecbs";
+  result.algorithm = name();
   auto timeUp = [&](const std::string& where) {
     result.message = "time limit reached (" + where + ")";
     result.runtime_s = since(t0);
@@ -294,43 +296,55 @@ PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& option
   };
   finish(*root);
 
-  // OPEN by lb; FOCAL: the open nodes with cost <= w * min lb, by fewest conflicts; WAITING: the rest, by cost
+  // CLEANUP: every open node by lb (its minimum is LB). FOCAL: the open nodes with cost <= w * threshold,
+  // by fewest conflicts; WAITING: the other open nodes, by cost. ECBS: threshold = LB. EECBS's explicit
+  // estimation (Li et al. 2021, here with the estimate = the node's cost): threshold = the least cost
+  // of an open node, and the node expanded is FOCAL's best if its cost <= w * LB, else the cheapest
+  // open node if within w * LB, else CLEANUP's best (which raises LB).
   using Ptr = std::shared_ptr<CtNode>;
   std::unordered_map<long, Ptr> nodes;
-  std::set<std::pair<long, long>> open, waiting;
+  std::set<std::pair<long, long>> cleanup, by_cost, waiting;
   std::set<std::tuple<int, long, long>> focal;
   long next_id = 0;
-  double lb_min = 0;
+  double threshold = static_cast<double>(root->lb);
   auto add = [&](const Ptr& node) {
     node->id = next_id++;
     nodes[node->id] = node;
-    open.insert({node->lb, node->id});
-    if (node->cost <= w * lb_min + 1e-9)
+    cleanup.insert({node->lb, node->id});
+    by_cost.insert({node->cost, node->id});
+    if (node->cost <= w * threshold + 1e-9)
       focal.insert({node->conflicts, node->cost, node->id});
     else
       waiting.insert({node->cost, node->id});
   };
-  lb_min = static_cast<double>(root->lb);
   add(root);
-  while (!focal.empty() || !open.empty())
+  while (!cleanup.empty())
   {
     if (Clock::now() > deadline) return timeUp("high level");
-    const double new_min = static_cast<double>(open.begin()->first);
-    if (new_min > lb_min || focal.empty())
+    const double lb_min = static_cast<double>(cleanup.begin()->first);
+    const double new_threshold = options.ecbs_explicit_estimation ? by_cost.begin()->first : lb_min;
+    if (new_threshold > threshold || focal.empty())
     {
-      lb_min = new_min;
-      while (!waiting.empty() && waiting.begin()->first <= w * lb_min + 1e-9)
+      threshold = new_threshold;
+      while (!waiting.empty() && waiting.begin()->first <= w * threshold + 1e-9)
       {
         const long id = waiting.begin()->second;
         waiting.erase(waiting.begin());
         focal.insert({nodes[id]->conflicts, nodes[id]->cost, id});
       }
     }
-    const long id = std::get<2>(*focal.begin());
-    focal.erase(focal.begin());
+    long id = std::get<2>(*focal.begin());
+    if (nodes[id]->cost > w * lb_min + 1e-9)  // only with explicit estimation: FOCAL reaches past w * LB
+    {
+      id = by_cost.begin()->first <= w * lb_min + 1e-9 ? by_cost.begin()->second : cleanup.begin()->second;
+      ++result.cleanup_expansions;
+    }
     Ptr node = nodes[id];
     nodes.erase(id);
-    open.erase({node->lb, id});
+    cleanup.erase({node->lb, id});
+    by_cost.erase({node->cost, id});
+    focal.erase({node->conflicts, node->cost, id});
+    waiting.erase({node->cost, id});
     ++result.attempts;
     if (node->conflicts == 0)
     {
@@ -342,8 +356,10 @@ PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& option
       result.runtime_s = since(t0);
       return result;
     }
-    const Conflict& k = node->conflict;
-    for (int side = 0; side < 2; ++side)
+    const Conflict k = node->conflict;
+    std::vector<Ptr> children;
+    bool bypassed = false;
+    for (int side = 0; side < 2 && !bypassed; ++side)
     {
       auto child = std::make_shared<CtNode>();
       child->parent = node;
@@ -364,8 +380,24 @@ PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& option
       child->f_min = node->f_min;
       child->f_min[agent] = std::max(node->f_min[agent], r.f_min);  // both bound this agent's cost here
       finish(*child);
-      add(child);
+      // Bypass (EECBS, Li et al. 2021): the new path also satisfies the parent's constraints; when it
+      // has fewer conflicts and keeps the parent within its bound, the parent takes it instead of splitting.
+      if (options.ecbs_bypass && child->conflicts < node->conflicts && child->cost <= w * node->lb + 1e-9)
+      {
+        node->paths = std::move(child->paths);
+        node->cost = child->cost;
+        node->conflicts = child->conflicts;
+        node->conflict = child->conflict;
+        bypassed = true;
+        ++result.bypasses;
+      }
+      else
+        children.push_back(child);
     }
+    if (bypassed)
+      add(node);
+    else
+      for (const auto& child : children) add(child);
   }
   result.message = "no solution exists (the constraint tree is exhausted)";
   result.runtime_s = since(t0);

@@ -39,13 +39,14 @@ PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& option
   return result;
 }
 
-std::vector<std::string> plannerNames() { return {"pp", "lacam", "ecbs", "auto"}; }
+std::vector<std::string> plannerNames() { return {"pp", "lacam", "ecbs", "eecbs", "auto"}; }
 
 std::unique_ptr<Planner> makePlanner(const std::string& name)
 {
   if (name == "pp") return std::make_unique<PrioritizedPlanner>();
   if (name == "lacam") return std::make_unique<LacamPlanner>();
   if (name == "ecbs") return std::make_unique<EcbsPlanner>();
+  if (name == "eecbs") return std::make_unique<EcbsPlanner>(true);
   if (name == "auto") return std::make_unique<AutoPlanner>();
   std::string known;
   for (const auto& n : plannerNames()) known += (known.empty() ? "" : ", ") + n;

@@ -2,6 +2,7 @@
 //   "pp"     prioritized planning with SIPP per agent, re-prioritised restarts (fast, incomplete)
 //   "lacam"  LaCAM (complete: finds a solution when one exists, given the time)
 //   "ecbs"   ECBS (bounded suboptimal: sum of costs <= w * optimum, with the proof in lower_bound)
+//   "eecbs"  ECBS with EECBS's bypassing and explicit-estimation node selection (same bound)
 //   "auto"   pp for part of the time limit, then lacam when pp could not solve it; then the
 //            solution is improved by large neighbourhood search for up to refine_s
 #pragma once
@@ -24,6 +25,10 @@ struct PlannerOptions
   double refine_s = 0.5;
   // ecbs: the suboptimality bound (>= 1; 1 is optimal CBS)
   double w = 1.05;
+  // ecbs: bypass conflicts (EECBS's rule: adopt a child's path with fewer conflicts within the bound)
+  bool ecbs_bypass = false;
+  // ecbs: EECBS's node selection (explicit estimation), see ecbs.cpp
+  bool ecbs_explicit_estimation = false;
 };
 
 struct PlanResult
@@ -39,6 +44,8 @@ struct PlanResult
   long lns_iterations = 0;
   // ecbs: a proven lower bound on the optimal sum of costs (sum of costs / lower_bound <= w); 0: none
   long lower_bound = 0;
+  long cleanup_expansions = 0;  // ecbs with explicit estimation: nodes expanded to raise the bound
+  long bypasses = 0;            // ecbs: conflicts resolved by bypassing instead of splitting
 };
 
 class Planner
@@ -71,11 +78,17 @@ public:
 
 // ECBS (Barer et al. 2014): conflict-based search, focal search on both levels (fewest conflicts
 // first within w of the lower bound). Sum of costs <= w * LB <= w * optimum; LB in lower_bound.
+// "eecbs": the same with EECBS's bypassing and node selection (Li, Ruml, Koenig 2021), whatever the
+// ecbs_* options say; "ecbs" follows them (defaults: plain ECBS).
 class EcbsPlanner : public Planner
 {
 public:
+  explicit EcbsPlanner(bool eecbs = false) : eecbs_(eecbs) {}
   PlanResult solve(const Instance& instance, const PlannerOptions& options) override;
-  std::string name() const override { return "ecbs"; }
+  std::string name() const override { return eecbs_ ? "eecbs" : "ecbs"; }
+
+private:
+  bool eecbs_;
 };
 
 // pp for options.pp_share of the time limit, then lacam for the rest; then LNS (lns.h) for up to

@@ -25,12 +25,12 @@ Grid mapOf(const std::vector<std::string>& rows)
   return parseMap(text, "test.map");
 }
 
-PlanResult ecbs(const Instance& inst, double w, double limit = 5.0)
+PlanResult ecbs(const Instance& inst, double w, double limit = 5.0, const std::string& name = "ecbs")
 {
   PlannerOptions options;
   options.time_limit_s = limit;
   options.w = w;
-  return makePlanner("ecbs")->solve(inst, options);
+  return makePlanner(name)->solve(inst, options);
 }
 
 // The optimal sum of costs (-1: no solution), by Dijkstra over (every agent's cell, which agents
@@ -121,9 +121,11 @@ TEST(Ecbs, OptimalWithW1AndBoundedWithW)
     if (optimum < 0) continue;  // unsolvable: CBS would search for ever (only the time limit ends it)
     ++compared;
     if (optimum > lowerBound(inst)) ++detours;
-    for (double w : {1.0, 1.5})
+    for (const auto& [name, w] :
+         std::vector<std::pair<std::string, double>>{{"ecbs", 1.0}, {"ecbs", 1.5}, {"eecbs", 1.0}, {"eecbs", 1.5}})
     {
-      const PlanResult r = ecbs(inst, w);
+      const PlanResult r = ecbs(inst, w, 30.0, name);  // a guard: one case needs ~34000 nodes
+      SCOPED_TRACE(name);
       ASSERT_TRUE(r.solved) << "trial " << trial << " w " << w << ": " << r.message;
       EXPECT_EQ(validate(inst, r.paths), "") << "trial " << trial;
       const long cost = sumOfCosts(r.paths);
@@ -163,9 +165,11 @@ TEST(Ecbs, BenchmarkInstanceWithinItsBound)
 {
   const Grid g = readMap(kDir + "/random-32-32-10.map");
   const Instance inst = instanceFromScen(g, readScen(kDir + "/random-32-32-10-random-1.scen", &g), 50);
-  for (double w : {1.05, 1.2})
+  for (const auto& [name, w] :
+       std::vector<std::pair<std::string, double>>{{"ecbs", 1.05}, {"eecbs", 1.05}, {"ecbs", 1.2}})
   {
-    const PlanResult r = ecbs(inst, w, 30.0);  // the limit only guards against a hang
+    SCOPED_TRACE(name);
+    const PlanResult r = ecbs(inst, w, 30.0, name);  // the limit only guards against a hang
     ASSERT_TRUE(r.solved) << "w " << w << ": " << r.message;
     EXPECT_EQ(validate(inst, r.paths), "");
     EXPECT_LE(sumOfCosts(r.paths), w * r.lower_bound + 1e-9) << "w " << w;

@@ -258,7 +258,7 @@ TEST(Planners, ByNameAndBadInput)
   }
   catch (const std::invalid_argument& e)
   {
-    EXPECT_STREQ(e.what(), "unknown MAPF algorithm 'cbs' (known: pp, lacam, ecbs, auto)");
+    EXPECT_STREQ(e.what(), "unknown MAPF algorithm 'cbs' (known: pp, lacam, ecbs, eecbs, auto)");
   }
   const Grid g = mapOf({"...."});
   Instance two_on_one_goal{&g, {g.id(0, 0), g.id(1, 0)}, {g.id(3, 0), g.id(3, 0)}};
