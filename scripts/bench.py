@@ -24,7 +24,7 @@
                                       same robots with a move_base goal each
                                       (mbot_bringup/fleet_bench.py)
     scripts/bench mapf [--json FILE] [--maps empty-32-32,...] [--time-limit S] [--max-agents K]
-                      [--algorithm auto|pp|lacam|ecbs] [--w W] [--agents 50,100]
+                      [--algorithm auto|pp|lacam|ecbs|eecbs] [--w W] [--agents 50,100]
                                       multi-agent path finding on the MovingAI instances
                                       (mbot_coordination/bench/mapf), the EECBS protocol: each map,
                                       scenarios 1..5, k = 10, 20, 30, ... agents until fewer than
@@ -299,7 +299,7 @@ def print_table(result):
                 f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
     if "mapf" in result:
         st = result["mapf_settings"]
-        name = st["algorithm"] + (" w=%g" % st["w"] if st["algorithm"] == "ecbs" else "")
+        name = st["algorithm"] + (" w=%g" % st["w"] if st["algorithm"] in ("ecbs", "eecbs") else "")
         print("\nMAPF (MovingAI instances, scenarios 1-5, %s, %g s limit; ratio = sum of costs / sum of the"
               " agents' own 4-connected shortest paths, mean over solved runs; proven = sum of costs / the"
               " planner's proven lower bound, mean and max)" % (name, st["time_limit_s"]))
@@ -344,8 +344,8 @@ def main(argv=None):
     parser.add_argument("--maps", default=",".join(MAPF_MAPS), help="mapf: map names (default: all five)")
     parser.add_argument("--time-limit", type=float, default=60.0, help="mapf: seconds per instance (default 60)")
     parser.add_argument("--max-agents", type=int, help="mapf: stop each map at this many agents")
-    parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp, lacam or ecbs (default auto)")
-    parser.add_argument("--w", type=float, default=1.05, help="mapf: ecbs's suboptimality bound (default 1.05)")
+    parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp, lacam, ecbs or eecbs (default auto)")
+    parser.add_argument("--w", type=float, default=1.05, help="mapf: ecbs's and eecbs's suboptimality bound (default 1.05)")
     parser.add_argument("--agents", help="mapf: only these agent counts, e.g. 50,100 (default: 10, 20, ... as the"
                         " protocol says)")
     args = parser.parse_args(argv)
@@ -371,8 +371,8 @@ def main(argv=None):
             parser.error("--time-limit must be > 0")
         if args.max_agents is not None and args.max_agents < 10:
             parser.error("--max-agents must be >= 10")
-        if args.algorithm not in ("auto", "pp", "lacam", "ecbs"):
-            parser.error("--algorithm: auto, pp, lacam or ecbs")
+        if args.algorithm not in ("auto", "pp", "lacam", "ecbs", "eecbs"):
+            parser.error("--algorithm: auto, pp, lacam, ecbs or eecbs")
         if not args.w >= 1.0:
             parser.error("--w must be >= 1")
         try:
