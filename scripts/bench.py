@@ -345,7 +345,8 @@ def main(argv=None):
     parser.add_argument("--time-limit", type=float, default=60.0, help="mapf: seconds per instance (default 60)")
     parser.add_argument("--max-agents", type=int, help="mapf: stop each map at this many agents")
     parser.add_argument("--algorithm", default="auto", help="mapf: auto, pp, lacam, ecbs or eecbs (default auto)")
-    parser.add_argument("--w", type=float, default=1.05, help="mapf: ecbs's and eecbs's suboptimality bound (default 1.05)")
+    parser.add_argument("--w", type=float, default=1.05,
+                        help="mapf: ecbs's and eecbs's suboptimality bound (default 1.05)")
     parser.add_argument("--agents", help="mapf: only these agent counts, e.g. 50,100 (default: 10, 20, ... as the"
                         " protocol says)")
     args = parser.parse_args(argv)
