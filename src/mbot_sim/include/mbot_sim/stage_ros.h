@@ -180,7 +180,7 @@ private:
   std::vector<geometry_msgs::TransformStamped> tf_batch_;  ///< all transforms of one step
   // /stage/ground_truth: every robot's ground truth of one step in one message, while subscribed
   ros::Publisher fleet_truth_pub_;
-  bool report_fleet_truth_ = false;      ///< someone subscribes (checked after each step)
+  bool report_fleet_truth_ = false;     ///< someone subscribes (checked after each step)
   mbot_msgs::RobotStates fleet_truth_;  ///< this step's ground truth samples
   double next_marker_time_ = 0.0;
   // /stage/applied_commands (end-to-end control latency): every robot's cmd_vels as the steps used them
