@@ -52,6 +52,36 @@ double nonNegative(const Reader& r, const YAML::Node& node, const std::string& k
   return v;
 }
 
+void readImuNoise(const Reader& r, const YAML::Node& imu, ImuNoiseConfig& out)
+{
+  r.checkKeys(imu, "noise.imu",
+              {"rate", "gyro_noise_density", "gyro_random_walk", "gyro_bias_init", "accel_noise_density",
+               "accel_random_walk", "accel_bias_init", "gyro_quantization", "accel_quantization", "time_offset"});
+  auto non_negative = [&](const char* key, const char* unit, double& value) {
+    if (imu[key]) value = nonNegative(r, imu[key], std::string("noise.imu.") + key, unit);
+  };
+  if (imu["rate"])
+  {
+    const std::string what = "a number in (0, 10000] [Hz]";
+    out.rate = positive(r, imu["rate"], "noise.imu.rate", "[Hz]");
+    if (out.rate > 10000.0) r.expected("noise.imu.rate", what, imu["rate"]);
+  }
+  non_negative("gyro_noise_density", "[rad/s/sqrt(Hz)]", out.gyro_noise_density);
+  non_negative("gyro_random_walk", "[rad/s^2/sqrt(Hz)]", out.gyro_random_walk);
+  non_negative("gyro_bias_init", "[rad/s]", out.gyro_bias_init);
+  non_negative("accel_noise_density", "[m/s^2/sqrt(Hz)]", out.accel_noise_density);
+  non_negative("accel_random_walk", "[m/s^3/sqrt(Hz)]", out.accel_random_walk);
+  non_negative("accel_bias_init", "[m/s^2]", out.accel_bias_init);
+  non_negative("gyro_quantization", "[rad/s]", out.gyro_quantization);
+  non_negative("accel_quantization", "[m/s^2]", out.accel_quantization);
+  if (imu["time_offset"])
+  {
+    const std::string what = "a number in [-1, 1] [s]";
+    out.time_offset = r.number(imu["time_offset"], "noise.imu.time_offset", what);
+    if (!(std::abs(out.time_offset) <= 1.0)) r.expected("noise.imu.time_offset", what, imu["time_offset"]);
+  }
+}
+
 std::string readName(const Reader& r, const YAML::Node& node, const std::string& key)
 {
   const std::string name = r.text(node, key, "a name");
@@ -265,13 +295,14 @@ WorldConfig loadWorldConfig(const std::string& path)
   if (root["noise"] && !root["noise"].IsNull())
   {
     const YAML::Node noise = root["noise"];
-    r.checkKeys(noise, "noise", {"laser_range", "odom_linear", "odom_angular"});
+    r.checkKeys(noise, "noise", {"laser_range", "odom_linear", "odom_angular", "imu"});
     if (noise["laser_range"])
       config.noise.laser_range = nonNegative(r, noise["laser_range"], "noise.laser_range", "[m]");
     if (noise["odom_linear"])
       config.noise.odom_linear = nonNegative(r, noise["odom_linear"], "noise.odom_linear", "[m/s]");
     if (noise["odom_angular"])
       config.noise.odom_angular = nonNegative(r, noise["odom_angular"], "noise.odom_angular", "[rad/s]");
+    if (noise["imu"] && !noise["imu"].IsNull()) readImuNoise(r, noise["imu"], config.noise.imu);
   }
 
   const std::vector<YAML::Node> faults = listOfMaps(r, root, "faults");

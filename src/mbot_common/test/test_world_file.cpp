@@ -68,6 +68,16 @@ TEST(WorldFile, ReadsEveryKey)
   EXPECT_DOUBLE_EQ(c.noise.laser_range, 0.01);
   EXPECT_DOUBLE_EQ(c.noise.odom_linear, 0.02);
   EXPECT_DOUBLE_EQ(c.noise.odom_angular, 0.03);
+  EXPECT_DOUBLE_EQ(c.noise.imu.rate, 400.0);
+  EXPECT_DOUBLE_EQ(c.noise.imu.gyro_noise_density, 0.001);
+  EXPECT_DOUBLE_EQ(c.noise.imu.gyro_random_walk, 0.0001);
+  EXPECT_DOUBLE_EQ(c.noise.imu.gyro_bias_init, 0.002);
+  EXPECT_DOUBLE_EQ(c.noise.imu.accel_noise_density, 0.01);
+  EXPECT_DOUBLE_EQ(c.noise.imu.accel_random_walk, 0.001);
+  EXPECT_DOUBLE_EQ(c.noise.imu.accel_bias_init, 0.03);
+  EXPECT_DOUBLE_EQ(c.noise.imu.gyro_quantization, 0.0002);
+  EXPECT_DOUBLE_EQ(c.noise.imu.accel_quantization, 0.002);
+  EXPECT_DOUBLE_EQ(c.noise.imu.time_offset, -0.004);
   ASSERT_EQ(c.faults.size(), 1u);
   EXPECT_EQ(c.faults[0].robot, "follower_1");
   EXPECT_DOUBLE_EQ(c.faults[0].faults.laser_dropout, 0.1);
@@ -88,6 +98,8 @@ TEST(WorldFile, DefaultsWhenOptionalKeysAreMissingOrEmpty)
     EXPECT_EQ(c.seed, 0u) << file;
     EXPECT_TRUE(c.robots.empty() && c.obstacles.empty() && c.moving_obstacles.empty() && c.faults.empty()) << file;
     EXPECT_DOUBLE_EQ(c.noise.laser_range, 0.0) << file;
+    EXPECT_DOUBLE_EQ(c.noise.imu.rate, 200.0) << file;  // the consumer MEMS defaults
+    EXPECT_DOUBLE_EQ(c.noise.imu.gyro_noise_density, 2.6e-4) << file;
   }
   const WorldConfig three = mbot_common::loadWorldConfig(kWorlds + "/valid_three_robots.world.yaml");
   ASSERT_EQ(three.robots.size(), 3u);

@@ -28,6 +28,7 @@ constexpr double kGroundTolerance = 1e-3;  // [m] a wheel centre may sit this fa
 const char* const kRootLink = "base_footprint";
 const char* const kBodyLink = "base_link";
 const char* const kLaserLink = "base_laser";
+const char* const kImuLink = "imu_link";
 
 std::string readFile(const std::string& path, const std::string& what)
 {
@@ -370,6 +371,19 @@ void readLaserMount(const UrdfReader& urdf, RobotModel& model)
   model.laser.mount_yaw = yawOf(mount.pose.rotation);
 }
 
+/// The IMU is optional (a model without imu_link has none); any fixed orientation is allowed.
+void readImuMount(const UrdfReader& urdf, RobotModel& model)
+{
+  if (!urdf.model().getLink(kImuLink)) return;
+  const LinkPose mount = urdf.linkPose(kImuLink);
+  if (!mount.rigid) urdf.fail(std::string("link ") + kImuLink, "expected a chain of fixed joints from base_footprint");
+  model.imu.present = true;
+  model.imu.xyz[0] = mount.pose.position.x;
+  model.imu.xyz[1] = mount.pose.position.y;
+  model.imu.xyz[2] = mount.pose.position.z;
+  mount.pose.rotation.getQuaternion(model.imu.q[0], model.imu.q[1], model.imu.q[2], model.imu.q[3]);
+}
+
 void readMass(const UrdfReader& urdf, RobotModel& model)
 {
   model.mass = 0.0;
@@ -388,6 +402,7 @@ RobotModel loadRobotModelFiles(const std::string& urdf_path, const std::string& 
   readFootprint(urdf, model);
   readWheels(urdf, config_path, model);
   readLaserMount(urdf, model);
+  readImuMount(urdf, model);
   readMass(urdf, model);
   return model;
 }

@@ -210,7 +210,11 @@ void StageRos::onReconfigure(SimulatorConfig& c)
   {
     try
     {
-      world_->setNoise(NoiseConfig{c.laser_range, c.odom_linear, c.odom_angular});
+      NoiseConfig noise = now;  // the IMU's part is not live-tunable: it stays
+      noise.laser_range = c.laser_range;
+      noise.odom_linear = c.odom_linear;
+      noise.odom_angular = c.odom_angular;
+      world_->setNoise(noise);
       ROS_INFO("stage_node: noise: laser_range %g m, odom_linear %g m/s, odom_angular %g rad/s from sim time %.3f s",
                c.laser_range, c.odom_linear, c.odom_angular, world_->time());
     }

@@ -76,12 +76,31 @@ struct MovingObstacleConfig
   std::string key;
 };
 
-/// @brief Gaussian standard deviations of sensor noise (0 = none).
+/// @brief Every robot's IMU and its errors, per axis, as Allan variance describes them (the
+///        world file's noise.imu). Defaults: a consumer MEMS IMU of the order of the TDK
+///        InvenSense ICM-20948 datasheet (noise densities, +-250 deg/s and +-2 g 16-bit steps);
+///        its random walks and bias spread are typical values, not datasheet figures.
+struct ImuNoiseConfig
+{
+  double rate = 200.0;                  ///< [Hz sim time]
+  double gyro_noise_density = 2.6e-4;   ///< white noise [rad/s/sqrt(Hz)]
+  double gyro_random_walk = 2.0e-5;     ///< bias random walk [rad/s^2/sqrt(Hz)]
+  double gyro_bias_init = 5.0e-3;       ///< std of the start bias [rad/s] (bias instability)
+  double accel_noise_density = 2.3e-3;  ///< white noise [m/s^2/sqrt(Hz)]
+  double accel_random_walk = 4.0e-4;    ///< bias random walk [m/s^3/sqrt(Hz)]
+  double accel_bias_init = 0.05;        ///< std of the start bias [m/s^2]
+  double gyro_quantization = 1.33e-4;   ///< output step [rad/s] (0: none)
+  double accel_quantization = 6.0e-4;   ///< output step [m/s^2] (0: none)
+  double time_offset = 0.0;             ///< stamp minus the true measurement time [s], in [-1, 1]
+};
+
+/// @brief Gaussian standard deviations of sensor noise (0 = none), and the IMU's error model.
 struct NoiseConfig
 {
   double laser_range = 0.0;   ///< [m] per beam
   double odom_linear = 0.0;   ///< [m/s] on the measured linear velocity
   double odom_angular = 0.0;  ///< [rad/s] on the measured angular velocity
+  ImuNoiseConfig imu;         ///< fixed at start (not live-tunable)
 };
 
 /// @brief Faults of one robot (the fields of mbot_msgs/SetFault).

@@ -29,8 +29,18 @@ Obstacle = namedtuple("Obstacle", "name shape pose key")
 #: yielding in [0, 1]: how much it gives way to bodies within personal_radius [m] of its outline
 #: (0: a blind waypoint follower).
 MovingObstacle = namedtuple("MovingObstacle", "name shape waypoints speed mode yielding personal_radius key")
-#: Standard deviations of sensor noise: laser_range [m], odom_linear [m/s], odom_angular [rad/s].
-Noise = namedtuple("Noise", "laser_range odom_linear odom_angular")
+#: Every robot's IMU error model (noise.imu; world_file.h ImuNoiseConfig has the units): rate [Hz],
+#: white noise densities, bias random walks, start-bias spreads, quantization steps, time_offset [s].
+IMU_KEYS = ["rate", "gyro_noise_density", "gyro_random_walk", "gyro_bias_init", "accel_noise_density",
+            "accel_random_walk", "accel_bias_init", "gyro_quantization", "accel_quantization", "time_offset"]
+ImuNoise = namedtuple("ImuNoise", IMU_KEYS)
+#: The defaults: a consumer MEMS IMU of the order of the ICM-20948 datasheet (as world_file.h).
+IMU_DEFAULTS = ImuNoise(200.0, 2.6e-4, 2.0e-5, 5.0e-3, 2.3e-3, 4.0e-4, 0.05, 1.33e-4, 6.0e-4, 0.0)
+_IMU_UNITS = ["[Hz]", "[rad/s/sqrt(Hz)]", "[rad/s^2/sqrt(Hz)]", "[rad/s]", "[m/s^2/sqrt(Hz)]",
+              "[m/s^3/sqrt(Hz)]", "[m/s^2]", "[rad/s]", "[m/s^2]", "[s]"]
+#: Standard deviations of sensor noise: laser_range [m], odom_linear [m/s], odom_angular [rad/s];
+#: imu: ImuNoise.
+Noise = namedtuple("Noise", "laser_range odom_linear odom_angular imu", defaults=(IMU_DEFAULTS,))
 #: Faults of a robot (mbot_msgs/SetFault): laser_dropout [0, 1], sensor_latency [s],
 #: sensor_jitter [s], odom_drift [rad/s], drive_frozen, silenced.
 Faults = namedtuple("Faults", "laser_dropout sensor_latency sensor_jitter odom_drift drive_frozen silenced")
@@ -46,6 +56,23 @@ TOP_KEYS = ["map", "physics_step", "real_time_factor", "seed", "robots", "obstac
             "noise", "faults"]
 FAULT_KEYS = ["laser_dropout", "sensor_latency", "sensor_jitter", "odom_drift", "drive_frozen", "silenced"]
 NO_FAULTS = Faults(0.0, 0.0, 0.0, 0.0, False, False)
+
+
+def _imu_noise(ir):
+    """noise.imu, checked as world_file.cpp's readImuNoise()."""
+    ir.check_keys(IMU_KEYS)
+    values = []
+    for key, unit, default in zip(IMU_KEYS, _IMU_UNITS, IMU_DEFAULTS):
+        if key == "rate":
+            value = ir.optional(key, float, default, what="a number > 0 [Hz]", check=lambda v: v > 0.0)
+            if value > 10000.0:
+                ir.expected(key, "a number in (0, 10000] [Hz]", ir.data[key])
+        elif key == "time_offset":
+            value = ir.optional(key, float, default, what="a number in [-1, 1] [s]", check=lambda v: abs(v) <= 1.0)
+        else:
+            value = ir.optional(key, float, default, what="a number >= 0 " + unit, check=lambda v: v >= 0.0)
+        values.append(value)
+    return ImuNoise(*values)
 
 
 def check_name(name):
@@ -216,12 +243,12 @@ def load_world(path):
                                                "moving_obstacles[%d]" % i))
 
     nr = r.child("noise", required=False)
-    nr.check_keys(["laser_range", "odom_linear", "odom_angular"])
+    nr.check_keys(["laser_range", "odom_linear", "odom_angular", "imu"])
 
     def non_negative(key, unit):
         return nr.optional(key, float, 0.0, what="a number >= 0 " + unit, check=lambda v: v >= 0.0)
     noise = Noise(non_negative("laser_range", "[m]"), non_negative("odom_linear", "[m/s]"),
-                  non_negative("odom_angular", "[rad/s]"))
+                  non_negative("odom_angular", "[rad/s]"), _imu_noise(nr.child("imu", required=False)))
 
     faults = []
     for i, fr in enumerate(r.children("faults", required=False)):

@@ -8,7 +8,7 @@ import pytest
 from common_fixture_cases import WORLDS, invalid_fixtures
 from mbot_common.geometry import Pose2D
 from mbot_common.strict_yaml import ConfigError
-from mbot_common.world import Faults, check_faults, check_name, load_world
+from mbot_common.world import IMU_DEFAULTS, Faults, ImuNoise, check_faults, check_name, load_world
 
 
 def test_reads_every_key():
@@ -34,7 +34,8 @@ def test_reads_every_key():
     assert (cart.name, cart.mode, cart.shape.type) == ("moving_obstacle_1", "loop", "box")
     assert (person.yielding, person.personal_radius) == (0.5, 1.2)
     assert (cart.yielding, cart.personal_radius) == (1.0, 0.8)  # the defaults
-    assert tuple(w.noise) == (0.01, 0.02, 0.03)
+    assert tuple(w.noise[:3]) == (0.01, 0.02, 0.03)
+    assert w.noise.imu == ImuNoise(400.0, 0.001, 0.0001, 0.002, 0.01, 0.001, 0.03, 0.0002, 0.002, -0.004)
     assert len(w.faults) == 1 and w.faults[0].robot == "follower_1"
     assert w.faults[0].faults == Faults(0.1, 0.05, 0.01, 0.02, False, True)
 
@@ -44,7 +45,8 @@ def test_defaults_when_optional_keys_are_missing_or_empty(name):
     w = load_world(os.path.join(WORLDS, name))
     assert (w.physics_step, w.real_time_factor, w.seed) == (0.01, 1.0, 0)
     assert w.robots == [] and w.obstacles == [] and w.moving_obstacles == [] and w.faults == []
-    assert tuple(w.noise) == (0.0, 0.0, 0.0)
+    assert tuple(w.noise[:3]) == (0.0, 0.0, 0.0)
+    assert w.noise.imu == IMU_DEFAULTS  # the consumer MEMS defaults
 
 
 def test_three_robots():

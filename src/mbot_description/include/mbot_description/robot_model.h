@@ -85,6 +85,14 @@ struct WheelJointFrame
   double axis[3] = {0.0, 1.0, 0.0};           ///< unit vector
 };
 
+/// @brief IMU mount (URDF link `imu_link`, optional): its pose in base_footprint.
+struct ImuMount
+{
+  bool present = false;                ///< the URDF has an imu_link
+  double xyz[3] = {0.0, 0.0, 0.0};     ///< [m]
+  double q[4] = {0.0, 0.0, 0.0, 1.0};  ///< rotation x, y, z, w (imu_link in base_footprint)
+};
+
 /// @brief Everything the simulator and the navigation need to know about one robot model.
 struct RobotModel
 {
@@ -99,6 +107,7 @@ struct RobotModel
   std::vector<std::string> wheel_joints;      ///< unprefixed URDF joint names of the driven wheels
   std::vector<WheelJointFrame> wheel_frames;  ///< the same joints' frames, in the same order
   LaserSpec laser;
+  ImuMount imu;
   Limits limits;
   double odom_rate = 50.0;          ///< [Hz]
   double ground_truth_rate = 50.0;  ///< [Hz]

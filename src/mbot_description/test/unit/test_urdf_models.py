@@ -26,7 +26,10 @@ def test_check_urdf_accepts(model):
 @pytest.mark.parametrize("model", MODELS)
 def test_every_body_has_mass_and_inertia(model):
     links = load(model).findall("link")
-    bodies = [link for link in links if link.get("name") != "base_footprint"]
+    # Frames (no geometry: base_footprint, imu_link) are not bodies and carry no inertial.
+    bodies = [link for link in links if link.find("visual") is not None or link.find("collision") is not None]
+    frames = [link for link in links if link not in bodies]
+    assert all(link.find("inertial") is None for link in frames)
     assert len(bodies) >= 4
     for link in bodies:
         inertial = link.find("inertial")

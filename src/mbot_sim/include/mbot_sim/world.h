@@ -39,6 +39,7 @@ namespace mbot_sim
 using mbot_common::checkFaults;
 using mbot_common::checkName;
 using mbot_common::FaultConfig;
+using mbot_common::ImuNoiseConfig;
 using mbot_common::loadMap;
 using mbot_common::loadWorldConfig;
 using mbot_common::MapError;
@@ -98,6 +99,14 @@ struct ScanSample
                               ///< NaN: no measurement (laser_dropout)
 };
 
+/// @brief One IMU sample in the robot's imu_link frame (REP-145: a raw gyro and accelerometer).
+struct ImuSample
+{
+  double stamp = 0.0;                               ///< measurement sim time + noise.imu.time_offset [s]
+  double angular_velocity[3] = {0.0, 0.0, 0.0};     ///< [rad/s] with bias, noise, quantization
+  double linear_acceleration[3] = {0.0, 0.0, 0.0};  ///< specific force [m/s^2]: +g on z at rest
+};
+
 /// @brief Two bodies started touching.
 struct ContactEvent
 {
@@ -127,6 +136,10 @@ public:
   virtual void onGroundTruth(int /*robot*/, const GroundTruthSample& /*sample*/) {}
   virtual void onJointState(int /*robot*/, const JointStateSample& /*sample*/) {}
   virtual void onScan(int /*robot*/, const ScanSample& /*sample*/) {}
+  /// @brief Asked every step for each robot with an IMU: false and its IMU does not measure
+  ///        (nobody listens; its bias still walks), so fleets without IMU users pay nothing.
+  virtual bool wantsImu(int /*robot*/) const { return true; }
+  virtual void onImu(int /*robot*/, const ImuSample& /*sample*/) {}
   virtual void onContact(const ContactEvent& /*event*/) {}
 };
 
@@ -190,7 +203,8 @@ public:
   /// @throws SimError: unknown robot, a value out of range
   void setFaults(const std::string& name, const FaultConfig& faults);
   /// @brief Replace the sensor noise of every robot (live tuning); in force from the next step.
-  ///        Each robot keeps drawing from its own random stream.
+  ///        Each robot keeps drawing from its own random stream. noise.imu is not changed (the
+  ///        IMU error model is fixed when the robots are made).
   /// @throws SimError: a value that is negative or not finite (the noise is then unchanged)
   void setNoise(const NoiseConfig& noise);
   /// @brief Every robot back to its start pose at rest with its odometry at identity; moving

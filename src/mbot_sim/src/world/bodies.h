@@ -7,6 +7,7 @@
  */
 #pragma once
 
+#include "imu.h"
 #include "mbot_sim/raycast.h"
 #include "mbot_sim/world.h"
 
@@ -159,6 +160,8 @@ struct Robot
   std::deque<Pending<JointStateSample>> pending_joints;
   std::deque<Pending<ScanSample>> pending_scans;
   double last_release = 0.0;
+
+  ImuState imu;  ///< its own timer, random stream and latency queue (imu.h)
 };
 
 struct Obstacle

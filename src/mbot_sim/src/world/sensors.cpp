@@ -1,12 +1,14 @@
 /**
  * @file sensors.cpp
- * @brief Sensor timers, the laser scan (walls and bodies), and handing samples to the listener,
+ * @brief Sensor timers, the laser scan (walls and bodies), the IMU's samples, and handing samples to the listener,
  *        at once or after a latency fault's delay. See sensors.h.
  */
 #include "sensors.h"
 
 #include "odometry.h"
 
+#include <algorithm>
+#include <cmath>
 #include <deque>
 
 namespace mbot_sim
@@ -93,6 +95,67 @@ void Sensors::run(double now, const NoiseConfig& noise, SensorListener* listener
     releasePending(r, now, listener, r.pending_odom, &SensorListener::onOdometry);
     releasePending(r, now, listener, r.pending_joints, &SensorListener::onJointState);
     releasePending(r, now, listener, r.pending_scans, &SensorListener::onScan);
+    if (r.imu.present) runImu(r, now, listener);
+  }
+}
+
+void Sensors::runImu(Robot& r, double now, SensorListener* listener)
+{
+  ImuState& s = r.imu;
+  ImuErrors& errors = *s.errors;
+  const double period = errors.period();
+  const Twist2D v = r.velocity;
+  // Derivatives over the step just done (zero at the first step and after a teleport).
+  const bool have_last = s.last_time >= 0.0 && now > s.last_time + kTimeEpsilon;
+  const Twist2D last = have_last ? s.last_velocity : v;
+  const double last_time = have_last ? s.last_time : now;
+  const double dt = have_last ? now - s.last_time : 1.0;
+  const double dvx = (v.vx - last.vx) / dt, dvy = (v.vy - last.vy) / dt, alpha = (v.wz - last.wz) / dt;
+  s.last_velocity = v;
+  s.last_time = now;
+
+  const bool active = listener && !r.faults.silenced && listener->wantsImu(r.id);
+  if (!active)  // skip the due samples; the bias walks over the gap at the next sample
+  {
+    const long long due_k = static_cast<long long>(std::floor((now + kTimeEpsilon - s.start) / period));
+    s.k = std::max(s.k, due_k + 1);
+  }
+  else
+  {
+    std::array<double, 3> gyro{}, accel{};
+    for (double t = s.start + s.k * period; t <= now + kTimeEpsilon; t = s.start + (++s.k) * period)
+    {
+      // The motion at t: velocities interpolated over the step, derivatives constant in it.
+      const double f = dt > 0.0 ? std::min(1.0, std::max(0.0, (t - last_time) / dt)) : 1.0;
+      Twist2D vt;
+      vt.vx = last.vx + f * (v.vx - last.vx);
+      vt.vy = last.vy + f * (v.vy - last.vy);
+      vt.wz = last.wz + f * (v.wz - last.wz);
+      s.mount.measure(vt, dvx, dvy, alpha, gyro, accel);
+      errors.walk(t - period - s.bias_time);  // a gap nobody listened to (apply walks one period)
+      s.bias_time = t;
+      ImuSample sample;
+      sample.stamp = t + errors.config().time_offset;
+      errors.apply(gyro, accel, sample);
+      if (delayed(r))
+      {
+        // Its own jitter draws, so the other sensors' noise does not depend on IMU listeners.
+        const FaultConfig& fault = r.faults;
+        double release = t + fault.sensor_latency;
+        if (fault.sensor_jitter > 0.0) release += std::abs(fault.sensor_jitter * errors.gauss());
+        s.last_release = std::max(release, s.last_release);
+        s.pending.emplace_back(s.last_release, sample);
+      }
+      else
+      {
+        listener->onImu(r.id, sample);
+      }
+    }
+  }
+  while (!s.pending.empty() && s.pending.front().first <= now + kTimeEpsilon)
+  {
+    if (listener && !r.faults.silenced) listener->onImu(r.id, s.pending.front().second);
+    s.pending.pop_front();
   }
 }
 

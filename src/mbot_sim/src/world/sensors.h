@@ -35,6 +35,9 @@ private:
                    const std::vector<std::unique_ptr<Mover>>& movers);
   void addShape(const Outline& outline, const Pose2D& pose, int owner);
   void measureScan(Robot& r, double now, const NoiseConfig& noise);
+  /// The IMU samples due in the step that ended at `now` (several per step when its rate is
+  /// above the physics rate), each at its own time on the IMU's grid.
+  void runImu(Robot& r, double now, SensorListener* listener);
 
   GridRaycaster grid_;
   ShapeSet shapes_;

@@ -118,6 +118,15 @@ struct World::Impl
   {
     if (!(settings.physics_step > 0.0 && settings.physics_step <= 0.1))
       throw SimError("physics_step: expected a number in (0, 0.1] [s], got " + std::to_string(settings.physics_step));
+    const ImuNoiseConfig& imu = settings.noise.imu;
+    if (!(imu.rate > 0.0 && imu.rate <= 10000.0))
+      throw SimError("noise.imu.rate: expected a number in (0, 10000] [Hz], got " + std::to_string(imu.rate));
+    for (double v : {imu.gyro_noise_density, imu.gyro_random_walk, imu.gyro_bias_init, imu.accel_noise_density,
+                     imu.accel_random_walk, imu.accel_bias_init, imu.gyro_quantization, imu.accel_quantization})
+      if (!(std::isfinite(v) && v >= 0.0))
+        throw SimError("noise.imu: expected finite numbers >= 0, got " + std::to_string(v));
+    if (!(std::abs(imu.time_offset) <= 1.0))
+      throw SimError("noise.imu.time_offset: expected a number in [-1, 1] [s], got " + std::to_string(imu.time_offset));
     if (std::abs(map.origin_yaw) > 1e-9)
       throw SimError("the map's origin yaw is " + std::to_string(map.origin_yaw) +
                      "; stage_node supports only maps with yaw 0");
@@ -288,6 +297,12 @@ struct World::Impl
     spec.range_max = model.laser.range_max;
     spec.ignore_owner = id;
     robot->scan.ranges.assign(static_cast<size_t>(std::max(0, model.laser.beams)), 0.0f);
+    ImuState& imu = robot->imu;
+    imu.present = model.imu.present;
+    imu.mount = ImuMountFrame(model.imu);
+    imu.errors = std::make_unique<ImuErrors>(settings.noise.imu, settings.seed, id);
+    imu.start = time();
+    imu.bias_time = time();
 
     names.insert(name);
     robot_by_id.push_back(robot.get());
@@ -423,6 +438,8 @@ struct World::Impl
       throw SimError("robot " + name + " at " + formatPoint(pose.x, pose.y) + " would overlap " + other->describe());
     const Pose2D odom_frame = mbot_common::compose(r.pose, mbot_common::inverse(r.odom));  // in the map
     placeBody(r, pose);
+    // A jump, not a motion: no acceleration spike for the IMU.
+    r.imu.last_time = -1.0;
     if (odometry_follows)
     {
       r.odom = mbot_common::relative(odom_frame, r.pose);
@@ -449,7 +466,9 @@ struct World::Impl
     check("laser_range", noise.laser_range, "[m]");
     check("odom_linear", noise.odom_linear, "[m/s]");
     check("odom_angular", noise.odom_angular, "[rad/s]");
+    const ImuNoiseConfig imu = settings.noise.imu;  // fixed at start: the biases were drawn from it
     settings.noise = noise;
+    settings.noise.imu = imu;
   }
 
   void resetPositions()
@@ -466,6 +485,8 @@ struct World::Impl
       r->pending_odom.clear();
       r->pending_joints.clear();
       r->pending_scans.clear();
+      r->imu.pending.clear();
+      r->imu.last_time = -1.0;
       r->last_release = time();
     }
     for (auto& m : movers)
