@@ -82,6 +82,51 @@ void readImuNoise(const Reader& r, const YAML::Node& imu, ImuNoiseConfig& out)
   }
 }
 
+/// A robot's `lidar:` (true / false / a map of its settings).
+LidarConfig readLidar(const Reader& r, const YAML::Node& node, const std::string& key)
+{
+  LidarConfig lidar;
+  const std::string what = "true, false or a map of lidar settings";
+  if (!node.IsMap())
+  {
+    bool on = false;
+    if (!node.IsScalar() || node.Tag() == "!" || !YAML::convert<bool>::decode(node, on)) r.expected(key, what, node);
+    lidar.enabled = on;
+    return lidar;
+  }
+  lidar.enabled = true;
+  r.checkKeys(node, key,
+              {"rate", "points_per_frame", "min_elevation", "max_elevation", "range_min", "range_max", "range_noise",
+               "range_quantization"});
+  auto sub = [&](const char* k) { return Reader::join(key, k); };
+  if (node["rate"]) lidar.rate = positive(r, node["rate"], sub("rate"), "[Hz]");
+  if (node["points_per_frame"])
+  {
+    const long long n = r.integer(node["points_per_frame"], sub("points_per_frame"), "an integer in [1, 1000000]");
+    if (n < 1 || n > 1000000)
+      r.expected(sub("points_per_frame"), "an integer in [1, 1000000]", node["points_per_frame"]);
+    lidar.points_per_frame = static_cast<int>(n);
+  }
+  const std::string el_what = "a number in (-90, 90) [deg]";
+  for (const char* k : {"min_elevation", "max_elevation"})
+  {
+    if (!node[k]) continue;
+    const double v = r.number(node[k], sub(k), el_what);
+    if (!(v > -90.0 && v < 90.0)) r.expected(sub(k), el_what, node[k]);
+    (std::string(k) == "min_elevation" ? lidar.min_elevation : lidar.max_elevation) = v;
+  }
+  if (!(lidar.max_elevation > lidar.min_elevation))
+    r.fail(sub("max_elevation"), "expected more than min_elevation (" + formatNumber(lidar.min_elevation) + " deg)");
+  if (node["range_min"]) lidar.range_min = nonNegative(r, node["range_min"], sub("range_min"), "[m]");
+  if (node["range_max"]) lidar.range_max = positive(r, node["range_max"], sub("range_max"), "[m]");
+  if (!(lidar.range_max > lidar.range_min))
+    r.fail(sub("range_max"), "expected more than range_min (" + formatNumber(lidar.range_min) + " m)");
+  if (node["range_noise"]) lidar.range_noise = nonNegative(r, node["range_noise"], sub("range_noise"), "[m]");
+  if (node["range_quantization"])
+    lidar.range_quantization = nonNegative(r, node["range_quantization"], sub("range_quantization"), "[m]");
+  return lidar;
+}
+
 std::string readName(const Reader& r, const YAML::Node& node, const std::string& key)
 {
   const std::string name = r.text(node, key, "a name");
@@ -183,10 +228,10 @@ WorldConfig loadWorldConfig(const std::string& path)
 {
   const Reader r(path);
   const YAML::Node root = r.load();
-  r.checkKeys(
-      root, "",
-      {"map", "physics_step", "real_time_factor", "seed", "robots", "obstacles", "moving_obstacles", "noise", "faults"},
-      {"map"});
+  r.checkKeys(root, "",
+              {"map", "physics_step", "real_time_factor", "seed", "robots", "obstacles", "moving_obstacles", "noise",
+               "faults", "wall_height"},
+              {"map"});
 
   WorldConfig config;
   config.file = path;
@@ -201,6 +246,7 @@ WorldConfig loadWorldConfig(const std::string& path)
   }
   if (root["real_time_factor"])
     config.real_time_factor = nonNegative(r, root["real_time_factor"], "real_time_factor", "(0 = as fast as possible)");
+  if (root["wall_height"]) config.wall_height = positive(r, root["wall_height"], "wall_height", "[m]");
   if (root["seed"])
   {
     const long long seed = r.integer(root["seed"], "seed", "an integer >= 0");
@@ -221,11 +267,12 @@ WorldConfig loadWorldConfig(const std::string& path)
     const YAML::Node& item = robots[i];
     RobotConfig robot;
     robot.key = Reader::index("robots", i);
-    r.checkKeys(item, robot.key, {"name", "model", "pose"}, {"name", "pose"});
+    r.checkKeys(item, robot.key, {"name", "model", "pose", "lidar"}, {"name", "pose"});
     robot.name = readName(r, item["name"], Reader::join(robot.key, "name"));
     claim(robot.name, Reader::join(robot.key, "name"));
     if (item["model"]) robot.model = readName(r, item["model"], Reader::join(robot.key, "model"));
     robot.pose = readPose(r, item["pose"], Reader::join(robot.key, "pose"));
+    if (item["lidar"]) robot.lidar = readLidar(r, item["lidar"], Reader::join(robot.key, "lidar"));
     config.robots.push_back(robot);
   }
 
@@ -235,12 +282,13 @@ WorldConfig loadWorldConfig(const std::string& path)
     const YAML::Node& item = obstacles[i];
     ObstacleConfig obstacle;
     obstacle.key = Reader::index("obstacles", i);
-    r.checkKeys(item, obstacle.key, {"name", "shape", "size", "radius", "pose"}, {"shape", "pose"});
+    r.checkKeys(item, obstacle.key, {"name", "shape", "size", "radius", "pose", "height"}, {"shape", "pose"});
     obstacle.name =
         item["name"] ? readName(r, item["name"], Reader::join(obstacle.key, "name")) : "obstacle_" + std::to_string(i);
     claim(obstacle.name, Reader::join(obstacle.key, "name"));
     obstacle.shape = readShape(r, item, obstacle.key);
     obstacle.pose = readPose(r, item["pose"], Reader::join(obstacle.key, "pose"));
+    if (item["height"]) obstacle.height = positive(r, item["height"], Reader::join(obstacle.key, "height"), "[m]");
     config.obstacles.push_back(obstacle);
   }
 
@@ -250,9 +298,10 @@ WorldConfig loadWorldConfig(const std::string& path)
     const YAML::Node& item = movers[i];
     MovingObstacleConfig mover;
     mover.key = Reader::index("moving_obstacles", i);
-    r.checkKeys(item, mover.key,
-                {"name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius"},
-                {"shape", "waypoints", "speed"});
+    r.checkKeys(
+        item, mover.key,
+        {"name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius", "height"},
+        {"shape", "waypoints", "speed"});
     mover.name = item["name"] ? readName(r, item["name"], Reader::join(mover.key, "name"))
                               : "moving_obstacle_" + std::to_string(i);
     claim(mover.name, Reader::join(mover.key, "name"));
@@ -289,6 +338,7 @@ WorldConfig loadWorldConfig(const std::string& path)
     }
     if (item["personal_radius"])
       mover.personal_radius = positive(r, item["personal_radius"], Reader::join(mover.key, "personal_radius"), "[m]");
+    if (item["height"]) mover.height = positive(r, item["height"], Reader::join(mover.key, "height"), "[m]");
     config.moving_obstacles.push_back(mover);
   }
 

@@ -140,3 +140,29 @@ TEST(WorldFile, NamesAndFaultRanges)
   f.sensor_jitter = 10.5;
   EXPECT_EQ(mbot_common::checkFaults(f), "sensor_jitter: expected a standard deviation in [0, 10] s, got 10.5");
 }
+
+TEST(WorldFile, LidarAndHeights)
+{
+  const WorldConfig c = mbot_common::loadWorldConfig(kWorlds + "/valid_lidar.world.yaml");
+  EXPECT_EQ(c.wall_height, 3.0);
+  ASSERT_EQ(c.robots.size(), 3u);
+  const mbot_common::LidarConfig& l = c.robots[0].lidar;
+  EXPECT_TRUE(l.enabled);
+  EXPECT_EQ(l.rate, 20.0);
+  EXPECT_EQ(l.points_per_frame, 1000);
+  EXPECT_EQ(l.min_elevation, -10.0);
+  EXPECT_EQ(l.max_elevation, 45.0);
+  EXPECT_EQ(l.range_min, 0.2);
+  EXPECT_EQ(l.range_max, 30.0);
+  EXPECT_EQ(l.range_noise, 0.01);
+  EXPECT_EQ(l.range_quantization, 0.002);
+  const mbot_common::LidarConfig defaults;
+  EXPECT_TRUE(c.robots[1].lidar.enabled);  // lidar: true: the Mid-360 defaults
+  EXPECT_EQ(c.robots[1].lidar.points_per_frame, defaults.points_per_frame);
+  EXPECT_EQ(c.robots[1].lidar.range_noise, defaults.range_noise);
+  EXPECT_FALSE(c.robots[2].lidar.enabled);
+  EXPECT_EQ(c.obstacles.at(0).height, 0.3);
+  EXPECT_EQ(c.moving_obstacles.at(0).height, 1.8);
+  const WorldConfig m = mbot_common::loadWorldConfig(kWorlds + "/valid_minimal.world.yaml");
+  EXPECT_EQ(m.wall_height, 2.5);
+}

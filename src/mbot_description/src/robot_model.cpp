@@ -358,6 +358,42 @@ void readWheels(const UrdfReader& urdf, const std::string& config_path, RobotMod
                      formatNumber(min_y));
 }
 
+/// The 3D lidar is optional (a model without lidar_link has none); it must be level, as the
+/// simulator's 2.5D world has no roll or pitch.
+void readLidarMount(const UrdfReader& urdf, RobotModel& model)
+{
+  const char* const link = "lidar_link";
+  if (!urdf.model().getLink(link)) return;
+  const LinkPose mount = urdf.linkPose(link);
+  if (!mount.rigid) urdf.fail(std::string("link ") + link, "expected a chain of fixed joints from base_footprint");
+  if (!isUpright(mount.pose.rotation))
+    urdf.fail(std::string("link ") + link, "expected a level lidar (roll = pitch = 0)");
+  model.lidar.present = true;
+  model.lidar.x = mount.pose.position.x;
+  model.lidar.y = mount.pose.position.y;
+  model.lidar.z = mount.pose.position.z;
+  model.lidar.yaw = yawOf(mount.pose.rotation);
+}
+
+/// The robot's height: the top of its highest collision box, cylinder or sphere (taken upright).
+void readHeight(const UrdfReader& urdf, RobotModel& model)
+{
+  model.height = 0.0;
+  for (const auto& item : urdf.model().links_)
+  {
+    if (!item.second->collision || !item.second->collision->geometry) continue;
+    const auto [geometry, pose] = urdf.collision(item.first);
+    double half = 0.0;
+    if (geometry->type == urdf::Geometry::BOX)
+      half = static_cast<const urdf::Box&>(*geometry).dim.z / 2.0;
+    else if (geometry->type == urdf::Geometry::CYLINDER)
+      half = static_cast<const urdf::Cylinder&>(*geometry).length / 2.0;
+    else if (geometry->type == urdf::Geometry::SPHERE)
+      half = static_cast<const urdf::Sphere&>(*geometry).radius;
+    model.height = std::max(model.height, pose.position.z + half);
+  }
+}
+
 void readLaserMount(const UrdfReader& urdf, RobotModel& model)
 {
   const LinkPose mount = urdf.linkPose(kLaserLink);
@@ -399,6 +435,8 @@ RobotModel loadRobotModelFiles(const std::string& urdf_path, const std::string& 
   RobotModel model = readSettings(config_path);
   const UrdfReader urdf(urdf_path);
   model.name = urdf.model().getName();
+  readLidarMount(urdf, model);
+  readHeight(urdf, model);
   readFootprint(urdf, model);
   readWheels(urdf, config_path, model);
   readLaserMount(urdf, model);

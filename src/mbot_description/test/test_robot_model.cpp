@@ -100,7 +100,13 @@ TEST(RobotModel, MbotMatchesItsUrdf)
   EXPECT_NEAR(m.laser.mount_y, 0.0, kEps);
   EXPECT_NEAR(m.laser.mount_z, 0.16, kEps);
   EXPECT_NEAR(m.laser.mount_yaw, 0.0, kEps);
-  EXPECT_NEAR(m.mass, 2.0 + 2 * 0.1 + 0.05 + 0.15, kEps);
+  EXPECT_NEAR(m.mass, 2.0 + 2 * 0.1 + 0.05 + 0.15 + 0.265, kEps);
+  // the 3D lidar's mount and the robot's height (the top of lidar_link's cylinder)
+  EXPECT_TRUE(m.lidar.present);
+  EXPECT_NEAR(m.lidar.x, -0.05, kEps);
+  EXPECT_NEAR(m.lidar.z, 0.26, kEps);
+  EXPECT_NEAR(m.lidar.yaw, 0.0, kEps);
+  EXPECT_NEAR(m.height, 0.29, kEps);
 
   EXPECT_EQ(m.laser.beams, 360);
   EXPECT_NEAR(m.laser.max_angle - m.laser.min_angle, 2 * kPi, 1e-12);
@@ -136,7 +142,11 @@ TEST(RobotModel, MbotOmniMatchesItsUrdf)
   EXPECT_EQ(m.wheel_joints.size(), 4u);
   EXPECT_NEAR(m.laser.mount_x, 0.10, kEps);
   EXPECT_NEAR(m.laser.mount_z, 0.16, kEps);
-  EXPECT_NEAR(m.mass, 3.0 + 4 * 0.12 + 0.15, kEps);
+  EXPECT_NEAR(m.mass, 3.0 + 4 * 0.12 + 0.15 + 0.265, kEps);
+  EXPECT_TRUE(m.lidar.present);
+  EXPECT_NEAR(m.lidar.x, -0.06, kEps);
+  EXPECT_NEAR(m.lidar.z, 0.26, kEps);
+  EXPECT_NEAR(m.height, 0.29, kEps);
   EXPECT_GT(m.limits.max_vel_y, 0.0);
   EXPECT_GT(m.limits.acc_lim_y, 0.0);
 }

@@ -86,6 +86,7 @@ void StageRos::addRobotIo(int id)
   io->scan_msg.range_min = m.laser.range_min;
   io->scan_msg.range_max = m.laser.range_max;
   for (const auto& joint : m.wheel_joints) io->joint_msg.name.push_back(io->prefix + joint);
+  addLidarIo(*io, id);
   // The wheels' transforms (as Gazebo's diff drive plugin's publishWheelTF): robot_state_publisher
   // then needs no joint_states, and publishes only the fixed joints, once, on /tf_static.
   for (const auto& frame : m.wheel_frames)

@@ -38,6 +38,21 @@ struct ShapeConfig
   double radius = 0.0;  ///< cylinder radius [m]
 };
 
+/// @brief A robot's 3D lidar (world file `robots[i].lidar`; a Livox Mid-360-like model in the
+///        simulator). Angles in degrees as on a datasheet.
+struct LidarConfig
+{
+  bool enabled = false;               ///< the robot has a lidar (`lidar: true` or a map of the keys)
+  double rate = 10.0;                 ///< frames per second [Hz]
+  int points_per_frame = 20000;       ///< pattern points per frame
+  double min_elevation = -7.0;        ///< [deg]
+  double max_elevation = 52.0;        ///< [deg]
+  double range_min = 0.1;             ///< [m]
+  double range_max = 40.0;            ///< [m]
+  double range_noise = 0.02;          ///< [m] Gaussian standard deviation per point
+  double range_quantization = 0.001;  ///< [m] ranges are multiples of this (0: exact)
+};
+
 /// @brief One robot of the world file.
 struct RobotConfig
 {
@@ -45,6 +60,7 @@ struct RobotConfig
   std::string model = "mbot";  ///< mbot_description model name
   Pose2D pose;                 ///< start pose in the map frame
   std::string key;             ///< where it came from in the file, e.g. "robots[1]" (for messages)
+  LidarConfig lidar;           ///< off unless the file asks for it
 };
 
 /// @brief A static box or cylinder besides the map walls.
@@ -54,6 +70,7 @@ struct ObstacleConfig
   ShapeConfig shape;
   Pose2D pose;
   std::string key;
+  double height = 1.0;  ///< [m] how tall the 3D lidar sees it
 };
 
 /// @brief A kinematic body that follows waypoints (people, carts); robots cannot push it. A
@@ -74,6 +91,7 @@ struct MovingObstacleConfig
   double yielding = 1.0;         ///< [0, 1] how much it gives way; 0: a blind waypoint follower
   double personal_radius = 0.8;  ///< [m] it reacts to bodies this close to its outline
   std::string key;
+  double height = 1.7;  ///< [m] how tall the 3D lidar sees it (a person)
 };
 
 /// @brief Every robot's IMU and its errors, per axis, as Allan variance describes them (the
@@ -132,6 +150,7 @@ struct WorldConfig
   OccupancyMap map_data;          ///< the loaded map
   double physics_step = 0.01;     ///< [s]
   double real_time_factor = 1.0;  ///< sim seconds per wall second; 0 = as fast as possible
+  double wall_height = 2.5;       ///< [m] the map's walls as the 3D lidar sees them
   unsigned seed = 0;              ///< seed of every random draw
   std::vector<RobotConfig> robots;
   std::vector<ObstacleConfig> obstacles;

@@ -22,13 +22,22 @@ from mbot_common.strict_yaml import ConfigError, Reader, load_yaml
 Shape = namedtuple("Shape", "type length width radius")
 #: A robot: name (its namespace and frame prefix), model (mbot_description), start pose in the
 #: map (Pose2D), key (where it is in the file, e.g. "robots[1]", for messages).
-Robot = namedtuple("Robot", "name model pose key")
+#: A robot's 3D lidar (robots[i].lidar: true, false or a map of LIDAR_KEYS; world_file.h
+#: LidarConfig): rate [Hz], points_per_frame, min/max_elevation [deg], range_min/max [m],
+#: range_noise [m] (Gaussian sigma), range_quantization [m].
+LIDAR_KEYS = ["rate", "points_per_frame", "min_elevation", "max_elevation", "range_min", "range_max", "range_noise",
+              "range_quantization"]
+Lidar = namedtuple("Lidar", ["enabled"] + LIDAR_KEYS)
+NO_LIDAR = Lidar(False, 10.0, 20000, -7.0, 52.0, 0.1, 40.0, 0.02, 0.001)
+Robot = namedtuple("Robot", "name model pose key lidar", defaults=(NO_LIDAR,))
 #: A static box or cylinder besides the map walls; pose: Pose2D in the map.
-Obstacle = namedtuple("Obstacle", "name shape pose key")
+#: height [m]: how tall the 3D lidar sees it.
+Obstacle = namedtuple("Obstacle", "name shape pose key height", defaults=(1.0,))
 #: A kinematic body that follows waypoints [(x, y) m] at speed [m/s]; mode "loop" or "ping_pong";
 #: yielding in [0, 1]: how much it gives way to bodies within personal_radius [m] of its outline
 #: (0: a blind waypoint follower).
-MovingObstacle = namedtuple("MovingObstacle", "name shape waypoints speed mode yielding personal_radius key")
+MovingObstacle = namedtuple("MovingObstacle", "name shape waypoints speed mode yielding personal_radius key height",
+                            defaults=(1.7,))
 #: Every robot's IMU error model (noise.imu; world_file.h ImuNoiseConfig has the units): rate [Hz],
 #: white noise densities, bias random walks, start-bias spreads, quantization steps, time_offset [s].
 IMU_KEYS = ["rate", "gyro_noise_density", "gyro_random_walk", "gyro_bias_init", "accel_noise_density",
@@ -50,10 +59,10 @@ RobotFaults = namedtuple("RobotFaults", "robot faults key")
 #: map_path: the map yaml (relative to the world file's directory); map_data: the loaded map
 #: (MapData); physics_step [s]; real_time_factor (0 = as fast as possible); seed.
 World = namedtuple("World", "file map map_path map_data physics_step real_time_factor seed robots obstacles "
-                            "moving_obstacles noise faults")
+                            "moving_obstacles noise faults wall_height", defaults=(2.5,))
 
 TOP_KEYS = ["map", "physics_step", "real_time_factor", "seed", "robots", "obstacles", "moving_obstacles",
-            "noise", "faults"]
+            "noise", "faults", "wall_height"]
 FAULT_KEYS = ["laser_dropout", "sensor_latency", "sensor_jitter", "odom_drift", "drive_frozen", "silenced"]
 NO_FAULTS = Faults(0.0, 0.0, 0.0, 0.0, False, False)
 
@@ -163,6 +172,37 @@ def _shape(r):
     r.expected("shape", "box or cylinder", r.data["shape"])
 
 
+def _lidar(rr):
+    """robots[i].lidar, checked as world_file.cpp's readLidar()."""
+    value = rr.required("lidar", object)
+    if isinstance(value, bool):
+        return NO_LIDAR._replace(enabled=value)
+    if not isinstance(value, dict):
+        rr.expected("lidar", "true, false or a map of lidar settings", value)
+    lr = rr.child("lidar")
+    lr.check_keys(LIDAR_KEYS)
+    rate = lr.optional("rate", float, NO_LIDAR.rate, what="a number > 0 [Hz]", check=lambda v: v > 0.0)
+    points = lr.optional("points_per_frame", int, NO_LIDAR.points_per_frame, what="an integer in [1, 1000000]",
+                         check=lambda v: 1 <= v <= 1000000)
+    elevation = "a number in (-90, 90) [deg]"
+    low = lr.optional("min_elevation", float, NO_LIDAR.min_elevation, what=elevation, check=lambda v: -90.0 < v < 90.0)
+    high = lr.optional("max_elevation", float, NO_LIDAR.max_elevation, what=elevation, check=lambda v: -90.0 < v < 90.0)
+    if not high > low:
+        lr.fail("max_elevation", "expected more than min_elevation (%g deg)" % low)
+    range_min = lr.optional("range_min", float, NO_LIDAR.range_min, what="a number >= 0 [m]", check=lambda v: v >= 0.0)
+    range_max = lr.optional("range_max", float, NO_LIDAR.range_max, what="a number > 0 [m]", check=lambda v: v > 0.0)
+    if not range_max > range_min:
+        lr.fail("range_max", "expected more than range_min (%g m)" % range_min)
+    noise = lr.optional("range_noise", float, NO_LIDAR.range_noise, what="a number >= 0 [m]", check=lambda v: v >= 0.0)
+    step = lr.optional("range_quantization", float, NO_LIDAR.range_quantization, what="a number >= 0 [m]",
+                       check=lambda v: v >= 0.0)
+    return Lidar(True, rate, points, low, high, range_min, range_max, noise, step)
+
+
+def _height(r, default):
+    return r.optional("height", float, default, what="a number > 0 [m]", check=lambda v: v > 0.0)
+
+
 def _pose(r, key="pose"):
     return Pose2D(*r.number_list(key, 3, what="a list of 3 numbers [x, y, yaw]"))
 
@@ -185,6 +225,7 @@ def load_world(path):
             r.expected("physics_step", "a number in (0, 0.1] [s]", r.data["physics_step"])
     real_time_factor = r.optional("real_time_factor", float, 1.0, what="a number >= 0 (0 = as fast as possible)",
                                   check=lambda v: v >= 0.0)
+    wall_height = r.optional("wall_height", float, 2.5, what="a number > 0 [m]", check=lambda v: v > 0.0)
     seed = r.optional("seed", int, 0, what="an integer >= 0")
     if not 0 <= seed <= 0xffffffff:
         r.expected("seed", "an integer in [0, 4294967295]", seed)
@@ -200,24 +241,26 @@ def load_world(path):
 
     robots = []
     for i, rr in enumerate(r.children("robots", required=False)):
-        rr.check_keys(["name", "model", "pose"], required=["name", "pose"])
+        rr.check_keys(["name", "model", "pose", "lidar"], required=["name", "pose"])
         name = _name(rr, "name")
         claim(rr, name)
         model = _name(rr, "model") if "model" in rr else "mbot"
-        robots.append(Robot(name, model, _pose(rr), "robots[%d]" % i))
+        pose = _pose(rr)
+        robots.append(Robot(name, model, pose, "robots[%d]" % i, _lidar(rr) if "lidar" in rr else NO_LIDAR))
 
     obstacles = []
     for i, orr in enumerate(r.children("obstacles", required=False)):
-        orr.check_keys(["name", "shape", "size", "radius", "pose"], required=["shape", "pose"])
+        orr.check_keys(["name", "shape", "size", "radius", "pose", "height"], required=["shape", "pose"])
         name = _name(orr, "name") if "name" in orr else "obstacle_%d" % i
         claim(orr, name)
         shape = _shape(orr)
-        obstacles.append(Obstacle(name, shape, _pose(orr), "obstacles[%d]" % i))
+        pose = _pose(orr)
+        obstacles.append(Obstacle(name, shape, pose, "obstacles[%d]" % i, _height(orr, 1.0)))
 
     moving_obstacles = []
     for i, mr in enumerate(r.children("moving_obstacles", required=False)):
-        mr.check_keys(["name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius"],
-                      required=["shape", "waypoints", "speed"])
+        mr.check_keys(["name", "shape", "size", "radius", "waypoints", "speed", "mode", "yielding", "personal_radius",
+                       "height"], required=["shape", "waypoints", "speed"])
         name = _name(mr, "name") if "name" in mr else "moving_obstacle_%d" % i
         claim(mr, name)
         shape = _shape(mr)
@@ -240,7 +283,7 @@ def load_world(path):
                                check=lambda v: 0.0 <= v <= 1.0)
         personal_radius = mr.optional("personal_radius", float, 0.8, what="a number > 0 [m]", check=lambda v: v > 0.0)
         moving_obstacles.append(MovingObstacle(name, shape, waypoints, speed, mode, yielding, personal_radius,
-                                               "moving_obstacles[%d]" % i))
+                                               "moving_obstacles[%d]" % i, _height(mr, 1.7)))
 
     nr = r.child("noise", required=False)
     nr.check_keys(["laser_range", "odom_linear", "odom_angular", "imu"])
@@ -272,4 +315,4 @@ def load_world(path):
     except ConfigError as error:
         raise ConfigError("%s: map: %s" % (path, error))
     return World(path, map_file, map_path, map_data, physics_step, real_time_factor, seed, robots, obstacles,
-                 moving_obstacles, noise, faults)
+                 moving_obstacles, noise, faults, wall_height)

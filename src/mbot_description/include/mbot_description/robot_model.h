@@ -62,6 +62,16 @@ struct LaserSpec
   }
 };
 
+/// @brief 3D lidar mount (URDF link `lidar_link`, optional): a level frame in base_footprint.
+struct LidarMount
+{
+  bool present = false;  ///< the URDF has a lidar_link
+  double x = 0.0;        ///< [m]
+  double y = 0.0;        ///< [m]
+  double z = 0.0;        ///< [m] above the ground
+  double yaw = 0.0;      ///< [rad]
+};
+
 /// @brief Velocity and acceleration limits, named as dwa_local_planner names them.
 struct Limits
 {
@@ -111,6 +121,8 @@ struct RobotModel
   Limits limits;
   double odom_rate = 50.0;          ///< [Hz]
   double ground_truth_rate = 50.0;  ///< [Hz]
+  LidarMount lidar;
+  double height = 0.0;  ///< top of the highest collision geometry above the ground [m]
 };
 
 /// @brief Load `<description_dir>/urdf/<model>.urdf` and `<description_dir>/config/<model>.yaml`.

@@ -189,7 +189,8 @@ public:
   size_t advance(const Scene25D& scene, const PrismQuery& near, double t0, const PlanarPose& p0, double t1,
                  const PlanarPose& p1, std::mt19937& rng, std::vector<LidarFrame>& done);
 
-  /// Drop the frame in progress and start a new one at `t` (after a teleport or reset).
+  /// Drop the frame in progress; the next starts on the first frame boundary (start + k / rate)
+  /// at or after `t` (after a teleport, a reset, or while nobody listens).
   void restart(double t);
 
   const LidarSpec& spec() const { return spec_; }
@@ -199,6 +200,7 @@ private:
   LidarSpec spec_;
   LidarPattern pattern_;
   double mount_x_, mount_y_, mount_z_, mount_yaw_;
+  double start_;         ///< [s] the first frame's start: frames begin at start_ + k / rate
   double frame_start_;   ///< [s]
   uint64_t next_point_;  ///< global pattern index of the next point to cast
   int in_frame_ = 0;     ///< pattern points of the current frame already cast

@@ -27,6 +27,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
@@ -98,6 +99,8 @@ public:
   void onGroundTruth(int robot, const GroundTruthSample& sample) override;
   void onJointState(int robot, const JointStateSample& sample) override;
   void onScan(int robot, const ScanSample& sample) override;
+  bool wantsPoints(int robot) const override;  ///< someone subscribes to its points topic
+  void onPointCloud(int robot, const LidarFrame& frame) override;
   void onContact(const ContactEvent& event) override;
 
 private:
@@ -112,6 +115,8 @@ private:
     sensor_msgs::LaserScan scan_msg;
     sensor_msgs::JointState joint_msg;
     geometry_msgs::TransformStamped odom_tf;
+    ros::Publisher points;  ///< only for a robot with a 3D lidar (stage_ros_lidar.cpp)
+    sensor_msgs::PointCloud2 cloud_msg;
     std::vector<geometry_msgs::TransformStamped> wheel_tf;  ///< parent link -> wheel, one per wheel joint
     double next_wheel_tf = 0.0;                             ///< sim time the wheels go out next [s]
     double last_cmd_time = -1e9;        ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
@@ -130,6 +135,8 @@ private:
 
   const mbot_description::RobotModel& model(const std::string& name);
   void addRobotIo(int robot);
+  /// The 3D lidar's topic and the cloud's fixed fields, for a robot that has one.
+  void addLidarIo(RobotIo& io, int robot);
   void publishRobotList();
   void publishMarkers();
   void publishClock();

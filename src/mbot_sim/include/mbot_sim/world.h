@@ -21,6 +21,8 @@
  */
 #pragma once
 
+#include "mbot_sim/lidar3d.h"
+
 #include <mbot_common/geometry.h>
 #include <mbot_common/map_io.h>
 #include <mbot_common/world_file.h>
@@ -40,6 +42,7 @@ using mbot_common::checkFaults;
 using mbot_common::checkName;
 using mbot_common::FaultConfig;
 using mbot_common::ImuNoiseConfig;
+using mbot_common::LidarConfig;
 using mbot_common::loadMap;
 using mbot_common::loadWorldConfig;
 using mbot_common::MapError;
@@ -140,6 +143,12 @@ public:
   ///        (nobody listens; its bias still walks), so fleets without IMU users pay nothing.
   virtual bool wantsImu(int /*robot*/) const { return true; }
   virtual void onImu(int /*robot*/, const ImuSample& /*sample*/) {}
+  /// @brief Asked every step for each robot with a 3D lidar: false and its lidar does not cast
+  ///        (nobody listens), so robots whose points nobody reads cost nothing.
+  virtual bool wantsPoints(int /*robot*/) const { return true; }
+  /// @brief A finished 3D lidar frame (lidar3d.h): points in the lidar frame, each with its time
+  ///        after the stamp (the sim time of the frame's first pattern point).
+  virtual void onPointCloud(int /*robot*/, const LidarFrame& /*frame*/) {}
   virtual void onContact(const ContactEvent& /*event*/) {}
 };
 
@@ -156,6 +165,7 @@ struct WorldSettings
   /// [s] a pair of bodies counts as separated (and a new touch is reported again) only after
   /// it has not touched for this long; stops flicker when a robot rests against a wall.
   double contact_release = 0.05;
+  double wall_height = 2.5;  ///< [m] the map's walls as the 3D lidars see them
 };
 
 /// @brief The simulation. Robots are addressed by an id (stable while the robot exists; a
@@ -245,6 +255,15 @@ public:
   size_t wallBoxCount() const;
   /// @brief Laser beams cast since the world was made.
   unsigned long long raysCast() const;
+
+  // ---- 3D lidar ----------------------------------------------------------------------------
+  /// @brief Give a robot a 3D lidar at its model's lidar_link (or take it away: enabled false).
+  ///        Its first frame starts at the current sim time.
+  /// @throws SimError: unknown robot, a model without lidar_link, a setting out of range
+  void setLidar(int robot, const LidarConfig& lidar);
+  bool hasLidar(int robot) const;
+  /// @brief 3D lidar rays cast since the world was made.
+  unsigned long long lidarRaysCast() const;
 
 private:
   struct Impl;

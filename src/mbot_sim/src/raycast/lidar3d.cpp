@@ -283,7 +283,10 @@ LidarScanner::LidarScanner(const LidarSpec& spec, double mount_x, double mount_y
 
 void LidarScanner::restart(double t)
 {
-  frame_start_ = t;
+  // The next frame starts on the first frame boundary from t: frames keep their phase.
+  const double period = 1.0 / spec_.rate;
+  const double k = std::ceil((t - start_) / period - 1e-9);
+  frame_start_ = start_ + std::max(0.0, k) * period;
   in_frame_ = 0;
   frame_.points.clear();
 }
@@ -339,7 +342,7 @@ size_t LidarScanner::advance(const Scene25D& scene, const PrismQuery& near, doub
       done.push_back(std::move(frame_));
       frame_ = LidarFrame();
       frame_.points.reserve(static_cast<size_t>(spec_.points_per_frame));
-      frame_start_ += period;
+      frame_start_ = start_ + std::round((frame_start_ - start_) / period + 1.0) * period;
       in_frame_ = 0;
     }
   }

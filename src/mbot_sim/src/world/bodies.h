@@ -161,6 +161,14 @@ struct Robot
   std::deque<Pending<ScanSample>> pending_scans;
   double last_release = 0.0;
 
+  // 3D lidar (none unless the world file asks): its pose at the end of the last step, to
+  // interpolate each point's pose; frames held back by a latency fault
+  std::unique_ptr<LidarScanner> lidar;
+  std::mt19937 lidar_rng;         ///< its own noise stream: other sensors' draws do not depend on it
+  double lidar_last_time = -1.0;  ///< [s] -1: no motion to interpolate (start, teleport)
+  Pose2D lidar_last_pose;
+  std::deque<Pending<LidarFrame>> pending_clouds;
+
   ImuState imu;  ///< its own timer, random stream and latency queue (imu.h)
 };
 
@@ -171,6 +179,7 @@ struct Obstacle
   Outline outline;
   Pose2D pose;
   GeomPtr geom;
+  double height = 1.0;  ///< [m] for the 3D lidar
 };
 
 /// A kinematic obstacle on a closed route (loop: back to the first waypoint; ping_pong: the

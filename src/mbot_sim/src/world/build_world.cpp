@@ -78,6 +78,7 @@ std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& 
   settings.physics_step = config.physics_step;
   settings.seed = config.seed;
   settings.noise = config.noise;
+  settings.wall_height = config.wall_height;
   settings.watchdog_timeout = watchdog_timeout;
   std::unique_ptr<World> world;
   try
@@ -129,6 +130,17 @@ std::unique_ptr<World> buildWorld(const WorldConfig& config, const ModelLoader& 
     catch (const SimError& e)
     {
       throw fail(r.key + ".pose", e.what());
+    }
+    if (r.lidar.enabled)
+    {
+      try
+      {
+        world->setLidar(world->findRobot(r.name), r.lidar);
+      }
+      catch (const SimError& e)
+      {
+        throw fail(r.key + ".lidar", e.what());
+      }
     }
   }
   for (const auto& f : config.faults)

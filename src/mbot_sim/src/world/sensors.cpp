@@ -48,6 +48,7 @@ void Sensors::run(double now, const NoiseConfig& noise, SensorListener* listener
                   const std::vector<std::unique_ptr<Mover>>& movers)
 {
   bool shapes_built = false;  // only when some laser is due
+  bool prisms_built = false;  // only when some 3D lidar casts
   for (const auto& robot : robots)
   {
     Robot& r = *robot;
@@ -95,6 +96,7 @@ void Sensors::run(double now, const NoiseConfig& noise, SensorListener* listener
     releasePending(r, now, listener, r.pending_odom, &SensorListener::onOdometry);
     releasePending(r, now, listener, r.pending_joints, &SensorListener::onJointState);
     releasePending(r, now, listener, r.pending_scans, &SensorListener::onScan);
+    if (r.lidar) runLidar(r, now, listener, robots, obstacles, movers, prisms_built);
     if (r.imu.present) runImu(r, now, listener);
   }
 }
@@ -192,6 +194,66 @@ void Sensors::addShape(const Outline& outline, const Pose2D& pose, int owner)
     c.owner = owner;
     shapes_.addCircle(c);
   }
+}
+
+void Sensors::addPrism(const Outline& outline, const Pose2D& pose, double height, int owner, float intensity)
+{
+  const Pose2D p = outlinePose(outline, pose);
+  Prism prism;
+  prism.is_box = outline.is_box;
+  prism.x = p.x;
+  prism.y = p.y;
+  prism.yaw = p.theta;
+  prism.radius = outline.radius;
+  prism.half_length = outline.half_length;
+  prism.half_width = outline.half_width;
+  prism.height = height;
+  prism.owner = owner;
+  prism.intensity = intensity;
+  scene_.addPrism(prism);
+}
+
+void Sensors::runLidar(Robot& r, double now, SensorListener* listener,
+                       const std::vector<std::unique_ptr<Robot>>& robots,
+                       const std::vector<std::unique_ptr<Obstacle>>& obstacles,
+                       const std::vector<std::unique_ptr<Mover>>& movers, bool& prisms_built)
+{
+  LidarScanner& lidar = *r.lidar;
+  const bool active = listener && !r.faults.silenced && listener->wantsPoints(r.id);
+  const bool moved_smoothly = r.lidar_last_time >= 0.0 && now > r.lidar_last_time + kTimeEpsilon;
+  if (!active || !moved_smoothly)
+  {
+    lidar.restart(now);  // nobody listens, or a jump: the next frame starts now
+  }
+  else
+  {
+    if (!prisms_built)
+    {
+      // Intensities per kind of body (a model: no reflectivity per material).
+      scene_.clearPrisms();
+      for (const auto& o : obstacles) addPrism(o->outline, o->pose, o->height, -1, 150.0f);
+      for (const auto& m : movers) addPrism(m->outline, m->pose, m->config.height, -1, 60.0f);
+      for (const auto& b : robots) addPrism(b->outline, b->pose, std::max(b->model.height, 0.05), b->id, 200.0f);
+      prisms_built = true;
+    }
+    // Bodies within reach of any point of the step: the range plus how far the robot moved.
+    const Pose2D& last = r.lidar_last_pose;
+    const double moved = std::hypot(r.pose.x - last.x, r.pose.y - last.y);
+    near_.prepare(scene_, r.pose.x, r.pose.y, lidar.spec().range_max + moved + 1.0, r.id);
+    frames_.clear();
+    lidar_rays_ += lidar.advance(scene_, near_, r.lidar_last_time, PlanarPose{last.x, last.y, last.theta}, now,
+                                 PlanarPose{r.pose.x, r.pose.y, r.pose.theta}, r.lidar_rng, frames_);
+    for (LidarFrame& frame : frames_)
+    {
+      if (delayed(r))
+        r.pending_clouds.push_back({releaseTime(r, now), std::move(frame)});
+      else
+        listener->onPointCloud(r.id, frame);
+    }
+  }
+  r.lidar_last_time = now;
+  r.lidar_last_pose = r.pose;
+  releasePending(r, now, listener, r.pending_clouds, &SensorListener::onPointCloud);
 }
 
 void Sensors::measureScan(Robot& r, double now, const NoiseConfig& noise)

@@ -163,6 +163,9 @@ struct World::Impl
     for (size_t i = 0; i < map.data.size(); ++i) occupied[i] = map.data[i] == 100 ? 1 : 0;
     sensors.setWalls(
         GridRaycaster(std::move(occupied), map.width, map.height, map.resolution, map.origin_x, map.origin_y));
+    if (!(settings.wall_height > 0.0) || !std::isfinite(settings.wall_height))
+      throw SimError("wall_height: expected a number > 0 [m], got " + std::to_string(settings.wall_height));
+    sensors.setWallHeight(settings.wall_height);
 
     for (const CellRect& r : mergeOccupiedCells(map))
     {
@@ -324,6 +327,9 @@ struct World::Impl
     claimName(config.name, "obstacle");
     const std::string size_problem = checkShapeSizes(config.shape);
     if (!size_problem.empty()) throw SimError("obstacle " + config.name + ": " + size_problem);
+    if (!(config.height > 0.0) || !std::isfinite(config.height))
+      throw SimError("obstacle " + config.name + ": height: expected a number > 0 [m], got " +
+                     formatNumber(config.height));
     const Pose2D& pose = config.pose;
     if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
       throw SimError("obstacle " + config.name + ": the pose is not finite");
@@ -331,6 +337,7 @@ struct World::Impl
       throw SimError("obstacle " + config.name + " at " + formatPoint(pose.x, pose.y) + " is outside the map");
     auto o = std::make_unique<Obstacle>();
     o->shape = config.shape;
+    o->height = config.height;
     o->outline = outlineOf(config.shape);
     o->pose = config.pose;
     o->tag.kind = BodyTag::Kind::OBSTACLE;
@@ -438,6 +445,7 @@ struct World::Impl
       throw SimError("robot " + name + " at " + formatPoint(pose.x, pose.y) + " would overlap " + other->describe());
     const Pose2D odom_frame = mbot_common::compose(r.pose, mbot_common::inverse(r.odom));  // in the map
     placeBody(r, pose);
+    r.lidar_last_time = -1.0;  // a jump: the lidar's frame restarts
     // A jump, not a motion: no acceleration spike for the IMU.
     r.imu.last_time = -1.0;
     if (odometry_follows)
@@ -485,6 +493,8 @@ struct World::Impl
       r->pending_odom.clear();
       r->pending_joints.clear();
       r->pending_scans.clear();
+      r->pending_clouds.clear();
+      r->lidar_last_time = -1.0;
       r->imu.pending.clear();
       r->imu.last_time = -1.0;
       r->last_release = time();
@@ -620,6 +630,50 @@ std::vector<ObstacleState> World::obstacles() const
 
 size_t World::wallBoxCount() const { return impl_->walls.size(); }
 unsigned long long World::raysCast() const { return impl_->sensors.raysCast(); }
+
+void World::setLidar(int robot, const LidarConfig& config)
+{
+  Robot& r = impl_->robotById(robot);
+  if (!config.enabled)
+  {
+    r.lidar.reset();
+    r.pending_clouds.clear();
+    return;
+  }
+  const auto& mount = r.model.lidar;
+  if (!mount.present)
+    throw SimError("robot " + r.tag.name + ": lidar: model " + r.model.name + " has no lidar_link in its URDF");
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  LidarSpec spec;
+  spec.rate = config.rate;
+  spec.points_per_frame = config.points_per_frame;
+  spec.min_elevation = config.min_elevation * kDeg;
+  spec.max_elevation = config.max_elevation * kDeg;
+  spec.range_min = config.range_min;
+  spec.range_max = config.range_max;
+  spec.range_noise = config.range_noise;
+  spec.range_quantization = config.range_quantization;
+  if (!(mount.z > 0.0 && mount.z < impl_->settings.wall_height))
+    throw SimError("robot " + r.tag.name + ": lidar: its lidar_link (" + formatNumber(mount.z) +
+                   " m up) must be above the floor and below the walls' top (wall_height " +
+                   formatNumber(impl_->settings.wall_height) + " m)");
+  try
+  {
+    r.lidar = std::make_unique<LidarScanner>(spec, mount.x, mount.y, mount.z, mount.yaw, time());
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw SimError("robot " + r.tag.name + ": lidar: " + e.what());
+  }
+  std::seed_seq seq{impl_->settings.seed, static_cast<unsigned>(robot), 0x11da7u};
+  r.lidar_rng.seed(seq);
+  r.lidar_last_time = time();
+  r.lidar_last_pose = r.pose;
+}
+
+bool World::hasLidar(int robot) const { return static_cast<bool>(impl_->robotById(robot).lidar); }
+
+unsigned long long World::lidarRaysCast() const { return impl_->sensors.lidarRaysCast(); }
 
 // =============================================================================================
 }  // namespace mbot_sim

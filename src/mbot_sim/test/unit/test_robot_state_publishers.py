@@ -86,7 +86,8 @@ def test_quaternion_from_rpy_is_urdfs_fixed_axis_order():
 def test_fixed_joints_are_the_urdfs_fixed_joints_with_their_origins():
     joints = fixed_joints(prefixed_description(DESCRIPTION_DIR, "mbot", "robot_7"))
     by_child = {child: (parent, xyz, q) for parent, child, xyz, q in joints}
-    assert sorted(by_child) == ["robot_7/base_laser", "robot_7/base_link", "robot_7/caster", "robot_7/imu_link"]
+    assert sorted(by_child) == ["robot_7/base_laser", "robot_7/base_link", "robot_7/caster", "robot_7/imu_link",
+                                "robot_7/lidar_link"]
     parent, xyz, q = by_child["robot_7/base_laser"]
     assert parent == "robot_7/base_link"
     assert xyz == pytest.approx((0.05, 0.0, 0.12))  # laser_joint in mbot.urdf
