@@ -9,6 +9,7 @@
 
 #include <mbot_msgs/Contact.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace mbot_sim
@@ -87,6 +88,21 @@ void StageRos::addRobotIo(int id)
   io->scan_msg.range_max = m.laser.range_max;
   for (const auto& joint : m.wheel_joints) io->joint_msg.name.push_back(io->prefix + joint);
   addLidarIo(*io, id);
+  if (m.imu.present)
+  {
+    // 400: 2 s at 200 Hz. A raw gyro and accelerometer (REP-145): no orientation (covariance -1);
+    // the diagonals are the variance of one white-noise sample, density^2 * rate.
+    io->imu = nh_.advertise<sensor_msgs::Imu>(ns + "imu", 400);
+    const ImuNoiseConfig& imu = world_->noise().imu;
+    io->imu_msg.header.frame_id = io->prefix + "imu_link";
+    io->imu_msg.orientation.w = 1.0;
+    io->imu_msg.orientation_covariance[0] = -1.0;
+    for (int i = 0; i < 3; ++i)
+    {
+      io->imu_msg.angular_velocity_covariance[4 * i] = imu.gyro_noise_density * imu.gyro_noise_density * imu.rate;
+      io->imu_msg.linear_acceleration_covariance[4 * i] = imu.accel_noise_density * imu.accel_noise_density * imu.rate;
+    }
+  }
   // The wheels' transforms (as Gazebo's diff drive plugin's publishWheelTF): robot_state_publisher
   // then needs no joint_states, and publishes only the fixed joints, once, on /tf_static.
   for (const auto& frame : m.wheel_frames)
@@ -163,6 +179,24 @@ void StageRos::onScan(int robot, const ScanSample& s)
   io.scan_msg.header.stamp.fromSec(s.stamp);
   io.scan_msg.ranges.assign(s.ranges.begin(), s.ranges.end());
   io.scan.publish(io.scan_msg);
+}
+
+bool StageRos::wantsImu(int robot) const
+{
+  return robot < static_cast<int>(io_.size()) && io_[robot] && io_[robot]->imu.getNumSubscribers() > 0;
+}
+
+void StageRos::onImu(int robot, const ImuSample& s)
+{
+  RobotIo& io = *io_[robot];
+  io.imu_msg.header.stamp.fromSec(std::max(0.0, s.stamp));  // a negative time_offset at start
+  io.imu_msg.angular_velocity.x = s.angular_velocity[0];
+  io.imu_msg.angular_velocity.y = s.angular_velocity[1];
+  io.imu_msg.angular_velocity.z = s.angular_velocity[2];
+  io.imu_msg.linear_acceleration.x = s.linear_acceleration[0];
+  io.imu_msg.linear_acceleration.y = s.linear_acceleration[1];
+  io.imu_msg.linear_acceleration.z = s.linear_acceleration[2];
+  io.imu.publish(io.imu_msg);
 }
 
 void StageRos::onContact(const ContactEvent& e)

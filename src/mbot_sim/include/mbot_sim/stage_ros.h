@@ -25,6 +25,7 @@
 #include <mbot_sim/SimulatorConfig.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -101,6 +102,8 @@ public:
   void onScan(int robot, const ScanSample& sample) override;
   bool wantsPoints(int robot) const override;  ///< someone subscribes to its points topic
   void onPointCloud(int robot, const LidarFrame& frame) override;
+  bool wantsImu(int robot) const override;  ///< someone subscribes to its imu topic
+  void onImu(int robot, const ImuSample& sample) override;
   void onContact(const ContactEvent& event) override;
 
 private:
@@ -117,6 +120,8 @@ private:
     geometry_msgs::TransformStamped odom_tf;
     ros::Publisher points;  ///< only for a robot with a 3D lidar (stage_ros_lidar.cpp)
     sensor_msgs::PointCloud2 cloud_msg;
+    ros::Publisher imu;  ///< only for a model with an imu_link; samples only while subscribed
+    sensor_msgs::Imu imu_msg;
     std::vector<geometry_msgs::TransformStamped> wheel_tf;  ///< parent link -> wheel, one per wheel joint
     double next_wheel_tf = 0.0;                             ///< sim time the wheels go out next [s]
     double last_cmd_time = -1e9;        ///< sim time of the last cmd_vel [s]; -1e9: never, or dropped
