@@ -88,6 +88,17 @@ class ControllerConfig(object):
         self.yield_time = 1.5              # how long to back away from what holds it [s]
         self.yield_speed = 0.15            # how fast [m/s]
         self.omni = False                  # True: holonomic robot (uses vy)
+        # the predictive law (mpc_law.py); the other laws ignore these
+        self.mpc_horizon = 15              # steps of the receding horizon [-]
+        self.mpc_step = 2                  # one step = this many control periods [-]
+        self.mpc_time_budget = 0.02        # a solve longer than this falls back to slot tracking [s wall]
+        self.mpc_q_position = 20.0         # weight of the slot error [1/m^2]
+        self.mpc_q_heading = 0.5           # weight of the heading error near the slot [1/rad^2]
+        self.mpc_r_velocity = 0.05         # weight of the command minus the slot's own velocity [s^2/m^2]
+        self.mpc_r_change = 0.2            # weight of the change of command from step to step [s^2/m^2]
+        self.mpc_robot_distance = 0.45     # least centre distance to a teammate's predicted path [m]
+        self.mpc_obstacle_distance = 0.25  # least distance from the centre to a laser point [m]
+        self.mpc_obstacle_range = 1.5      # laser points within this of the robot are constraints [m]
         if values:
             self.update(values)
 
@@ -112,6 +123,16 @@ class ControllerConfig(object):
         "yield_time": (float, lambda v: v >= 0, ">= 0"),
         "yield_speed": (float, lambda v: v >= 0, ">= 0"),
         "omni": (bool, None, None),
+        "mpc_horizon": (int, lambda v: 1 <= v <= 100, "in [1, 100]"),
+        "mpc_step": (int, lambda v: 1 <= v <= 20, "in [1, 20]"),
+        "mpc_time_budget": (float, lambda v: v > 0, "> 0"),
+        "mpc_q_position": (float, lambda v: v > 0, "> 0"),
+        "mpc_q_heading": (float, lambda v: v >= 0, ">= 0"),
+        "mpc_r_velocity": (float, lambda v: v >= 0, ">= 0"),
+        "mpc_r_change": (float, lambda v: v >= 0, ">= 0"),
+        "mpc_robot_distance": (float, lambda v: v >= 0, ">= 0"),
+        "mpc_obstacle_distance": (float, lambda v: v >= 0, ">= 0"),
+        "mpc_obstacle_range": (float, lambda v: v >= 0, ">= 0"),
     }
 
     def update(self, values):
@@ -126,6 +147,9 @@ class ControllerConfig(object):
             if kind is bool:
                 if not isinstance(value, bool):
                     raise ValueError("ControllerConfig: %s: expected true or false, got %r" % (key, value))
+            elif kind is int:
+                if isinstance(value, bool) or not isinstance(value, int) or not check(value):
+                    raise ValueError("ControllerConfig: %s: expected a whole number %s, got %r" % (key, wanted, value))
             else:
                 # ints are fine for a float (a gain of 1); bools and strings are not
                 if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -145,8 +169,12 @@ class ControllerConfig(object):
 
 #: What a control law needs, all in the leader frame: pose (Pose2D) of this follower, slot
 #: (x, y) its slot [m], leader_twist (Twist2D) of the leader in its body frame, neighbours a list
-#: of (Pose2D, (slot_x, slot_y)) of the other followers (may be empty).
-ControlInput = namedtuple("ControlInput", "pose slot leader_twist neighbours")
+#: of (Pose2D, (slot_x, slot_y)) of the other followers (may be empty). Only the predictive law
+#: (mpc) reads the rest: dt the control period [s], previous the command sent last (Twist2D),
+#: obstacles laser points (x, y) and teammates their predicted positions [(x, y) per step of
+#: the law's horizon], both in the same frame.
+ControlInput = namedtuple("ControlInput", "pose slot leader_twist neighbours dt previous obstacles teammates")
+ControlInput.__new__.__defaults__ = (None, None, (), ())
 
 
 def slot_velocity(slot, leader_twist):
@@ -178,6 +206,8 @@ def robot_command(u, pose, leader_twist, config):
 class SlotTracking(object):
     """u = v_s + k_position * (s - p): each follower drives to its own slot (the default)."""
 
+    smooth = True   # the command filter smooths its commands (the predictive law plans smooth ones)
+
     def compute(self, inp, config):
         vsx, vsy = slot_velocity(inp.slot, inp.leader_twist)
         ex, ey = inp.slot[0] - inp.pose.x, inp.slot[1] - inp.pose.y
@@ -187,6 +217,8 @@ class SlotTracking(object):
 
 class Consensus(object):
     """u_i = v_s_i + k_position (s_i - p_i) + k_consensus sum_j ((p_j - p_i) - (s_j - s_i))."""
+
+    smooth = True
 
     def compute(self, inp, config):
         vsx, vsy = slot_velocity(inp.slot, inp.leader_twist)
@@ -199,8 +231,15 @@ class Consensus(object):
         return robot_command((ux, uy), inp.pose, inp.leader_twist, config)
 
 
-# To add a law: a class with compute(inp, config) -> Twist2D, and its name here.
-CONTROL_LAWS = {"slot_tracking": SlotTracking, "consensus": Consensus}
+def _mpc_law():
+    # imported on use: only the predictive law needs cvxopt (and mpc_law imports this module)
+    from mbot_follower.mpc_law import MpcLaw
+    return MpcLaw()
+
+
+# To add a law: a class (or a function making one) with compute(inp, config) -> Twist2D and
+# smooth (True: the command filter smooths its commands), and its name here.
+CONTROL_LAWS = {"slot_tracking": SlotTracking, "consensus": Consensus, "mpc": _mpc_law}
 
 
 def make_control_law(name):
@@ -244,14 +283,15 @@ class CommandFilter(object):
         keeps turning at its full rate instead of starting its turn from zero every cycle."""
         self.previous = Twist2D(*cmd)
 
-    def apply(self, cmd, dt):
+    def apply(self, cmd, dt, smooth=True):
+        """smooth False: only limit (the predictive law's commands are planned within the limits)."""
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError("CommandFilter.apply: dt must be a finite time > 0 [s], got %r" % (dt,))
         if not all(math.isfinite(v) for v in cmd):
             raise ValueError("CommandFilter.apply: command must be finite, got %r" % (cmd,))
         c = self.config
         prev = self.previous
-        w = c.smoothing
+        w = c.smoothing if smooth else 1.0
         vx = w * cmd.vx + (1.0 - w) * prev.vx
         vy = w * cmd.vy + (1.0 - w) * prev.vy
         wz = w * cmd.wz + (1.0 - w) * prev.wz
@@ -456,8 +496,8 @@ def simulate(law, config, slots, starts, leader_twist_at, duration, dt=0.05, lea
         commands = []
         for i in range(len(followers)):
             neighbours = [(seen[j], slots[j]) for j in range(len(followers)) if j != i]
-            cmd = law.compute(ControlInput(seen[i], slots[i], twist, neighbours), config)
-            cmd = filters[i].apply(cmd, dt)
+            cmd = law.compute(ControlInput(seen[i], slots[i], twist, neighbours, dt, filters[i].previous), config)
+            cmd = filters[i].apply(cmd, dt, getattr(law, "smooth", True))
             if not config.omni:
                 cmd = Twist2D(cmd.vx, 0.0, cmd.wz)
             commands.append(cmd)
