@@ -252,6 +252,7 @@ AgentConstraints constraintsOf(const CtNode* node, int agent, int goal, int64_t 
 
 PlanResult EcbsPlanner::solve(const Instance& inst, const PlannerOptions& given)
 {
+  if (given.following) throw std::invalid_argument(name() + " does not support following conflicts (use pp or auto)");
   checkInstance(inst);
   PlannerOptions options = given;
   if (eecbs_) options.ecbs_bypass = options.ecbs_explicit_estimation = true;

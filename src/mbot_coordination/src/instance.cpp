@@ -61,7 +61,7 @@ void checkInstance(const Instance& inst)
                                   " is not reachable from its start " + cellName(g, inst.starts[i]));
 }
 
-std::string validate(const Instance& inst, const Paths& paths)
+std::string validate(const Instance& inst, const Paths& paths, bool following)
 {
   if (!inst.grid) return "instance has no grid";
   const Grid& g = *inst.grid;
@@ -108,6 +108,12 @@ std::string validate(const Instance& inst, const Paths& paths)
           return "edge conflict: agents " + std::to_string(i) + " and " + std::to_string(j) + " swap " +
                  cellName(g, prev) + " and " + cellName(g, cur) + " at t=" + std::to_string(t);
       }
+    if (following && t > 0)
+      for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < n; ++j)
+          if (i != j && at(i, t) == at(j, t - 1) && at(i, t - 1) != at(i, t))
+            return "following conflict: agent " + std::to_string(i) + " enters " + cellName(g, at(i, t)) +
+                   " at t=" + std::to_string(t) + ", left by agent " + std::to_string(j) + " at t=" + std::to_string(t);
     for (size_t i = 0; i < n; ++i) who[at(i, t)] = -1;
   }
   return "";

@@ -9,6 +9,7 @@
 #include <memory>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "mbot_coordination/planner.h"
@@ -221,6 +222,7 @@ private:
 
 PlanResult LacamPlanner::solve(const Instance& inst, const PlannerOptions& options)
 {
+  if (options.following) throw std::invalid_argument("lacam does not support following conflicts (use pp or auto)");
   checkInstance(inst);
   const auto t0 = Clock::now();
   const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(

@@ -8,7 +8,7 @@
 namespace mbot_coordination
 {
 LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadline, unsigned seed, int neighbourhood,
-                   long max_iterations)
+                   long max_iterations, bool following)
 {
   LnsStats stats;
   const Grid& g = *inst.grid;
@@ -61,7 +61,7 @@ LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadlin
     for (int i : all)
       if (static_cast<int>(group.size()) < size && in_group.insert(i).second) group.push_back(i);
 
-    ReservationTable table(g.size());
+    ReservationTable table(g.size(), following);
     long old_cost = 0;
     for (int i = 0; i < n; ++i)
       if (in_group.count(i))
@@ -72,9 +72,14 @@ LnsStats refineLns(const Instance& inst, Paths& paths, Clock::time_point deadlin
     std::vector<std::vector<int>> replanned;
     long new_cost = 0;
     bool timed_out = false;
-    for (int i : group)
+    for (size_t k = 0; k < group.size(); ++k)
     {
-      auto p = sippPath(g, table, inst.starts[i], inst.goals[i], h[i], deadline, &timed_out);
+      const int i = group[k];
+      ReservationTable with_starts = table;
+      if (following)  // the group's agents after i stand on their starts at t = 0 and must leave them
+        for (size_t j = k + 1; j < group.size(); ++j)
+          for (int t = 0; t <= 1; ++t) with_starts.reserveCell(inst.starts[group[j]], t);
+      auto p = sippPath(g, with_starts, inst.starts[i], inst.goals[i], h[i], deadline, &timed_out);
       if (p.empty()) break;
       new_cost += agentCost(p);
       if (new_cost >= old_cost) break;  // cannot win any more

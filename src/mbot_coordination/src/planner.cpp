@@ -13,9 +13,11 @@ PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& option
   checkInstance(inst);
   const auto t0 = Clock::now();
   PlannerOptions pp_options = options;
-  pp_options.time_limit_s = options.time_limit_s * std::clamp(options.pp_share, 0.0, 1.0);
+  // With following conflicts lacam cannot help: pp gets the whole time.
+  pp_options.time_limit_s =
+      options.following ? options.time_limit_s : options.time_limit_s * std::clamp(options.pp_share, 0.0, 1.0);
   PlanResult result = PrioritizedPlanner().solve(inst, pp_options);
-  if (!result.solved)
+  if (!result.solved && !options.following)
   {
     PlannerOptions rest = options;
     rest.time_limit_s = options.time_limit_s - std::chrono::duration<double>(Clock::now() - t0).count();
@@ -31,7 +33,7 @@ PlanResult AutoPlanner::solve(const Instance& inst, const PlannerOptions& option
                               0.0, std::min(options.time_limit_s, result.first_solution_s + options.refine_s))));
     if (options.refine_s > 0.0)
     {
-      result.lns_iterations = refineLns(inst, result.paths, end, options.seed).iterations;
+      result.lns_iterations = refineLns(inst, result.paths, end, options.seed, 8, -1, options.following).iterations;
       result.algorithm += "+lns";
     }
   }

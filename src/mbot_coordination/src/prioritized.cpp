@@ -30,13 +30,23 @@ PlanResult PrioritizedPlanner::solve(const Instance& inst, const PlannerOptions&
   while (true)
   {
     ++result.attempts;
-    ReservationTable table(g.size());
+    ReservationTable table(g.size(), options.following);
     Paths paths(n);
     int failed = -1;
     bool timed_out = false;
-    for (int i : order)
+    for (size_t k = 0; k < n; ++k)
     {
-      paths[i] = sippPath(g, table, inst.starts[i], inst.goals[i], h[i], deadline, &timed_out);
+      const int i = order[k];
+      if (options.following)
+      {
+        // The agents after i stand on their starts at t = 0: i may not enter one at t = 1.
+        ReservationTable with_starts = table;
+        for (size_t j = k + 1; j < n; ++j)
+          for (int t = 0; t <= 1; ++t) with_starts.reserveCell(inst.starts[order[j]], t);
+        paths[i] = sippPath(g, with_starts, inst.starts[i], inst.goals[i], h[i], deadline, &timed_out);
+      }
+      else
+        paths[i] = sippPath(g, table, inst.starts[i], inst.goals[i], h[i], deadline, &timed_out);
       if (paths[i].empty())
       {
         failed = i;

@@ -7,7 +7,8 @@
 
 namespace mbot_coordination
 {
-ReservationTable::ReservationTable(int cells) : safe_(cells, std::vector<SafeInterval>{{0, kForever}})
+ReservationTable::ReservationTable(int cells, bool following)
+    : safe_(cells, std::vector<SafeInterval>{{0, kForever}}), following_(following)
 {
   if (cells >= (1 << 21)) throw std::invalid_argument("ReservationTable: grid over 2^21 cells");
 }
@@ -45,9 +46,14 @@ void ReservationTable::reservePath(const std::vector<int>& path)
   for (int t = 0; t < last; ++t)
   {
     reserve(path[t], t);
+    if (following_)
+    {
+      if (t > 0) reserve(path[t], t - 1);
+      reserve(path[t], t + 1);
+    }
     if (path[t + 1] != path[t]) moves_.insert(key(path[t], path[t + 1], t + 1));
   }
-  reserveFrom(path[last], last);
+  reserveFrom(path[last], following_ && last > 0 ? last - 1 : last);
 }
 
 bool ReservationTable::swapBlocked(int from, int to, int t) const { return moves_.count(key(to, from, t)) != 0; }

@@ -31,7 +31,9 @@ using Paths = std::vector<std::vector<int>>;
 // goal, every step a wait or a move to a free 4-neighbour, no two agents in one cell at one time
 // (agents stay at their goals after their paths end), no two agents swapping cells in one step.
 // Otherwise the first problem found, e.g. "vertex conflict: agents 3 and 7 at (4,5) at t=12".
-std::string validate(const Instance& instance, const Paths& paths);
+// following: also "following conflict: agent 2 enters (4,5) at t=9, left by agent 5 at t=9"
+// (one agent in a cell one step after another was there).
+std::string validate(const Instance& instance, const Paths& paths, bool following = false);
 
 // An agent's cost: the time it reaches its goal for the last time (waiting there at the end is
 // free). Sum of costs and makespan as in the MAPF literature.

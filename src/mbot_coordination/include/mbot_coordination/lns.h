@@ -16,8 +16,9 @@ struct LnsStats
 
 // `paths` must solve `instance`; it is changed only by improvements. Stops at the deadline or
 // when the sum of costs reaches the lower bound, or after max_iterations (< 0: no limit).
-// neighbourhood: agents re-planned at a time.
+// neighbourhood: agents re-planned at a time. following: keep the solution free of following
+// conflicts too (it must be so already).
 LnsStats refineLns(const Instance& instance, Paths& paths, Clock::time_point deadline, unsigned seed,
-                   int neighbourhood = 8, long max_iterations = -1);
+                   int neighbourhood = 8, long max_iterations = -1, bool following = false);
 
 }  // namespace mbot_coordination

@@ -29,6 +29,10 @@ struct PlannerOptions
   bool ecbs_bypass = false;
   // ecbs: EECBS's node selection (explicit estimation), see ecbs.cpp
   bool ecbs_explicit_estimation = false;
+  // Forbid following conflicts too (an agent entering a cell another left one step before): the
+  // live planner's robots are not points. Supported by pp and auto (which then never falls back
+  // to lacam); lacam, ecbs and eecbs refuse it (std::invalid_argument).
+  bool following = false;
 };
 
 struct PlanResult

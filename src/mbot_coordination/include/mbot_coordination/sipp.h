@@ -22,12 +22,18 @@ struct SafeInterval
 };
 
 // The fixed agents' paths as safe intervals per cell and their moves (for swap conflicts).
+// following: also forbid following conflicts (entering a cell another agent was in one step
+// before, or being in a cell another agent enters one step later): each path cell is reserved at
+// t - 1, t and t + 1, so two agents keep at least one step between them in every cell.
 class ReservationTable
 {
 public:
-  explicit ReservationTable(int cells);
+  explicit ReservationTable(int cells, bool following = false);
   // The agent occupies path[t] at time t and its last cell from then on.
   void reservePath(const std::vector<int>& path);
+  // One cell at one time step (e.g. an agent not planned yet standing on its start at t = 0, 1).
+  void reserveCell(int cell, int t) { reserve(cell, t); }
+  bool following() const { return following_; }
   const std::vector<SafeInterval>& safeIntervals(int cell) const { return safe_[cell]; }
   // True when a fixed agent moves `to` -> `from` arriving at time t (moving from -> to then swaps).
   bool swapBlocked(int from, int to, int t) const;
@@ -39,6 +45,7 @@ private:
 
   std::vector<std::vector<SafeInterval>> safe_;
   std::unordered_set<uint64_t> moves_;
+  bool following_ = false;
 };
 
 using Clock = std::chrono::steady_clock;
