@@ -212,6 +212,44 @@ TEST(Imu, NobodyListeningNoSamplesAndAModelWithoutImuHasNone)
   EXPECT_NEAR(rec.samples.front().stamp, 1.005, 1e-9);
 }
 
+TEST(Imu, LatencyFaultDelaysSamplesKeepingStampsAndOrderSilencedDropsThem)
+{
+  struct Late : Recorder
+  {
+    const World* world = nullptr;
+    std::vector<double> arrived;
+    void onImu(int robot, const ImuSample& s) override
+    {
+      Recorder::onImu(robot, s);
+      arrived.push_back(world->time());
+    }
+  };
+  WorldSettings settings;
+  settings.noise.imu = noErrors();
+  World world(openMap(), settings);
+  world.addRobot("robot_0", imuModel(), {0.0, 0.0, 0.0});
+  Late rec;
+  rec.world = &world;
+  world.setListener(&rec);
+  FaultConfig late;
+  late.sensor_latency = 0.05;
+  late.sensor_jitter = 0.01;
+  world.setFaults("robot_0", late);
+  for (int i = 0; i < 200; ++i) world.step();
+  ASSERT_GT(rec.samples.size(), 380u);  // 400 measured in 2 s, the last ones still on their way
+  for (size_t i = 0; i < rec.samples.size(); ++i)
+  {
+    ASSERT_NEAR(rec.samples[i].stamp, 0.005 * (i + 1), 1e-9) << i;  // stamps: measurement times, in order
+    ASSERT_GE(rec.arrived[i], rec.samples[i].stamp + 0.05 - 1e-9) << i;
+  }
+  FaultConfig silenced;
+  silenced.silenced = true;
+  world.setFaults("robot_0", silenced);
+  const size_t before = rec.samples.size();
+  for (int i = 0; i < 100; ++i) world.step();
+  EXPECT_EQ(rec.samples.size(), before);
+}
+
 TEST(Imu, SameSeedSameSamplesOtherSeedOthers)
 {
   const ImuNoiseConfig c;  // the defaults
