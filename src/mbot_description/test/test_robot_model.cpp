@@ -107,6 +107,12 @@ TEST(RobotModel, MbotMatchesItsUrdf)
   EXPECT_NEAR(m.lidar.z, 0.26, kEps);
   EXPECT_NEAR(m.lidar.yaw, 0.0, kEps);
   EXPECT_NEAR(m.height, 0.29, kEps);
+  // the IMU's mount: imu_link, off the centre, axes as base_link
+  EXPECT_TRUE(m.imu.present);
+  EXPECT_NEAR(m.imu.xyz[0], -0.03, kEps);
+  EXPECT_NEAR(m.imu.xyz[1], 0.02, kEps);
+  EXPECT_NEAR(m.imu.xyz[2], 0.10, kEps);
+  EXPECT_NEAR(m.imu.q[3], 1.0, kEps);
 
   EXPECT_EQ(m.laser.beams, 360);
   EXPECT_NEAR(m.laser.max_angle - m.laser.min_angle, 2 * kPi, 1e-12);
@@ -147,6 +153,9 @@ TEST(RobotModel, MbotOmniMatchesItsUrdf)
   EXPECT_NEAR(m.lidar.x, -0.06, kEps);
   EXPECT_NEAR(m.lidar.z, 0.26, kEps);
   EXPECT_NEAR(m.height, 0.29, kEps);
+  EXPECT_TRUE(m.imu.present);
+  EXPECT_NEAR(m.imu.xyz[0], 0.05, kEps);
+  EXPECT_NEAR(m.imu.xyz[2], 0.09, kEps);
   EXPECT_GT(m.limits.max_vel_y, 0.0);
   EXPECT_GT(m.limits.acc_lim_y, 0.0);
 }
@@ -184,6 +193,7 @@ TEST(RobotModel, ComposesTheJointChain)
   EXPECT_NEAR(m.laser.mount_z, 0.2, kEps);
   EXPECT_NEAR(m.laser.mount_yaw, kPi / 2 - 0.5, kEps);
   EXPECT_NEAR(m.mass, 1.6, kEps);
+  EXPECT_FALSE(m.imu.present);  // no imu_link: no IMU
 
   // Settings come from the fixture, not from the defaults in robot_model.h.
   EXPECT_DOUBLE_EQ(m.limits.max_vel_x, 0.7);
