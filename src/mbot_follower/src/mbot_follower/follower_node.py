@@ -70,7 +70,7 @@ NODE_PARAMS = {
     "pose_wait": 0.1,         # how long to poll for a current pose before holding still [s wall]
     "max_scan_age": 0.3,      # an older laser scan stops the robot: the safety layer is blind [s]
     "tf_source": "relay",     # relay: only the robots it needs (fleet_tf_relay); tf: all of /tf
-    "controller": "slot_tracking",  # control law: slot_tracking or consensus
+    "controller": "slot_tracking",  # control law: slot_tracking, consensus or mpc
     "param_refresh": 0.5,     # how often the private parameters are read again [s sim time]
     "map_clearance": 0.25,    # a slot closer than this to a wall of /map is blocked [m]
     "scan_clearance": 0.35,   # a laser point closer than this to the way to the slot blocks it [m]
@@ -153,6 +153,7 @@ class FollowerController(object):
         self.cycle_failures = 0
         self.overruns = 0        # cycles whose computation took longer than the period [wall]
         self.late_starts = 0     # cycles that began a period or more after their time [sim]
+        self._mpc = None         # mpc_link.MpcLink, made when the mpc law first runs
 
     # --- parameters ---------------------------------------------------------------------------
 
@@ -351,8 +352,11 @@ class FollowerController(object):
             neighbours = self._neighbours(a, now, reference) if frame is ref_map else \
                 self._path_neighbours(a, now, frame)
         twist = frame_twist if mode in ("slot", "merge", "detour") else Twist2D(frame_twist.vx, 0.0, 0.0)
-        cmd = self.law.compute(ControlInput(pose, target, twist, neighbours), self.config)
-        cmd = self.filter.apply(cmd, 1.0 / self.params["rate"])
+        extra = self._mpc_inputs(a, frame, pose, twist, now, frame is ref_map, reference)
+        cmd = self.law.compute(ControlInput(pose, target, twist, neighbours, **extra), self.config)
+        if extra:
+            self._mpc.publish(self.law, frame, now.to_sec(), now)
+        cmd = self.filter.apply(cmd, 1.0 / self.params["rate"], getattr(self.law, "smooth", True))
         why = stale_scan(self.scan.header.stamp.to_sec() if self.scan is not None else None, now.to_sec(),
                          self.params["max_scan_age"])
         if why is not None:
@@ -375,6 +379,16 @@ class FollowerController(object):
         self._was_driving = True
         err = (slot[0] - pose.x, slot[1] - pose.y)
         self._publish_state(now, mode, started, stamp, err, -pose.theta, cmd)
+
+    def _mpc_inputs(self, a, frame, pose, twist, now, rigid, reference):
+        """The predictive law's extra inputs (none for the other laws: they cost nothing)."""
+        if self.params["controller"] != "mpc":
+            return {}
+        if self._mpc is None:
+            from mbot_follower.mpc_link import MpcLink
+            self._mpc = MpcLink(self.robot)
+        self._mpc.follow(a.slots)
+        return self._mpc.inputs(self, frame, pose, twist, now.to_sec(), rigid, reference)
 
     def _record_trail(self, a, reference, ref_map, now):
         """Add the leader's map position to its trails. In a chain the leader is not the robot
