@@ -271,8 +271,48 @@ TEST(Lidar3d, FramesTimesAndDeskew)
       on_wall += to_wall < 1e-4;
     }
     EXPECT_GT(on_wall, 100);
+    // each point along its pattern direction (the scanner walks the pattern without trigonometry)
+    const LidarPattern pattern(spec);
+    const uint64_t first = static_cast<uint64_t>(std::llround(f.stamp * spec.rate)) * spec.points_per_frame;
+    for (const auto& p : f.points)
+    {
+      double a = 0.0, e = 0.0;
+      pattern.direction(first + static_cast<uint64_t>(std::llround(p.time * spec.rate * spec.points_per_frame)), a, e);
+      const double r = std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z);
+      ASSERT_NEAR(p.z / r, std::sin(e), 1e-6);
+      ASSERT_NEAR(p.x / r, std::cos(e) * std::cos(a), 1e-6);
+      ASSERT_NEAR(p.y / r, std::cos(e) * std::sin(a), 1e-6);
+    }
     EXPECT_LE(f.points.size(), static_cast<size_t>(spec.points_per_frame));
   }
+}
+
+TEST(Lidar3d, FramesKeepTheirPhase)
+{
+  // A lidar switched on at sim time 5.0: frames at 5.0, 5.1, ...; after a pause (restart at
+  // 5.23) the next frame starts on the grid, at 5.3.
+  const GridRaycaster grid = room(80, 50);
+  const Scene25D scene(&grid, 2.5);
+  LidarSpec spec;
+  spec.points_per_frame = 1000;
+  LidarScanner scanner(spec, 0.0, 0.0, 0.3, 0.0, 5.0);
+  std::mt19937 rng(1);
+  std::vector<LidarFrame> frames;
+  PrismQuery q;
+  q.prepare(scene, 4.0, 2.5, 50.0, -1);
+  const PlanarPose pose{4.0, 2.5, 0.0};
+  double t = 5.0;
+  for (int k = 0; k < 20; ++k, t += 0.01) scanner.advance(scene, q, t, pose, t + 0.01, pose, rng, frames);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_NEAR(frames[0].stamp, 5.0, 1e-9);
+  EXPECT_NEAR(frames[1].stamp, 5.1, 1e-9);
+  frames.clear();
+  scanner.restart(5.23);
+  for (t = 5.23; t < 5.5; t += 0.01) scanner.advance(scene, q, t, pose, t + 0.01, pose, rng, frames);
+  ASSERT_EQ(frames.size(), 2u);  // 5.3 and 5.4 (5.5 still open)
+  EXPECT_NEAR(frames[0].stamp, 5.3, 1e-9);
+  EXPECT_NEAR(frames[1].stamp, 5.4, 1e-9);
+  EXPECT_GT(frames[0].points.size(), 500u);
 }
 
 TEST(Lidar3d, NoiseAndQuantization)

@@ -103,6 +103,11 @@ struct RayHit
 RayHit castRay3D(const Scene25D& scene, const PrismQuery& near, double x, double y, double z, double dir_x,
                  double dir_y, double elevation, double max_range);
 
+/// @brief As castRay3D() with the elevation given as its cosine and tangent (no trigonometry
+///        per ray: the scanner has them from its pattern).
+RayHit castRay3DTrig(const Scene25D& scene, const PrismQuery& near, double x, double y, double z, double dir_x,
+                     double dir_y, double cos_e, double tan_e, double max_range);
+
 /// @brief The same by brute force (small steps along the ray, `step` [m]): for tests only.
 RayHit castRay3DBruteForce(const Scene25D& scene, double x, double y, double z, double dir_x, double dir_y,
                            double elevation, double max_range, double step, int ignore_owner);
@@ -138,13 +143,30 @@ public:
   /// Azimuth [rad, in the lidar frame, any multiple of 2 pi] and elevation [rad] of point n.
   void direction(uint64_t n, double& azimuth, double& elevation) const;
 
+  /// @brief Walks the pattern point by point without trigonometry: the rotations are unit
+  ///        complex numbers turned by a fixed step per point (exact again at every seek()).
+  struct Cursor
+  {
+    uint64_t n = 0;
+    double c1 = 1.0, s1 = 0.0;  ///< e^{i w1 t}
+    double c2 = 1.0, s2 = 0.0;  ///< e^{i w2 t}
+    double ch = 1.0, sh = 0.0;  ///< e^{i 2 pi rate t} (the head)
+  };
+  void seek(uint64_t n, Cursor& c) const;
+  void next(Cursor& c) const;
+  /// cos and sin of the azimuth and of the elevation of the cursor's point (as direction()).
+  void unitDirection(const Cursor& c, double& cos_az, double& sin_az, double& cos_el, double& sin_el) const;
+
 private:
   LidarSpec spec_;
   double dt_;  ///< time between points [s]
   double w1_;  ///< rosette rotation rates [rad/s]
   double w2_;
-  double e_mid_;   ///< centre of the vertical field [rad]
-  double e_half_;  ///< half the vertical field [rad]
+  double e_mid_;                                                      ///< centre of the vertical field [rad]
+  double e_half_;                                                     ///< half the vertical field [rad]
+  double step1_c_, step1_s_, step2_c_, step2_s_, steph_c_, steph_s_;  ///< per-point rotations
+  double phase_c_[4], phase_s_[4];                                    ///< e^{i p_j} of the four channels
+  double cos_mid_, sin_mid_;                                          ///< of e_mid_
 };
 
 /// @brief One point: position in the lidar frame at its own time [m], intensity, and its time

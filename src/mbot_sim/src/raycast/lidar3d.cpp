@@ -21,8 +21,33 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr float kWallIntensity = 100.0f;
 constexpr float kFloorIntensity = 40.0f;
+constexpr double kGolden = 0.6180339887498949;  // the golden ratio's fraction
 
 bool finite(double v) { return std::isfinite(v); }
+
+/// sin and cos of |x| <= pi/2 by their Taylor series (error below 1e-11 there; the pattern's
+/// deflections stay within half the vertical field): no libm call per point.
+inline void sinCosSmall(double x, double& s, double& c)
+{
+  // Horner form with the reciprocals as constants: no division per point.
+  constexpr double k6 = 1.0 / 6, k20 = 1.0 / 20, k42 = 1.0 / 42, k72 = 1.0 / 72, k110 = 1.0 / 110, k156 = 1.0 / 156,
+                   k210 = 1.0 / 210;
+  constexpr double k2 = 1.0 / 2, k12 = 1.0 / 12, k30 = 1.0 / 30, k56 = 1.0 / 56, k90 = 1.0 / 90, k132 = 1.0 / 132,
+                   k182 = 1.0 / 182, k240 = 1.0 / 240;
+  const double x2 = x * x;
+  s = x *
+      (1.0 -
+       x2 * k6 *
+           (1.0 - x2 * k20 *
+                      (1.0 - x2 * k42 * (1.0 - x2 * k72 * (1.0 - x2 * k110 * (1.0 - x2 * k156 * (1.0 - x2 * k210)))))));
+  c = 1.0 -
+      x2 * k2 *
+          (1.0 -
+           x2 * k12 *
+               (1.0 -
+                x2 * k30 *
+                    (1.0 - x2 * k56 * (1.0 - x2 * k90 * (1.0 - x2 * k132 * (1.0 - x2 * k182 * (1.0 - x2 * k240)))))));
+}
 
 /// The horizontal interval [t_in, t_out] of the line o + t d inside the prism's footprint;
 /// false when the line misses it.
@@ -132,8 +157,12 @@ void PrismQuery::prepare(const Scene25D& scene, double x, double y, double reach
 RayHit castRay3D(const Scene25D& scene, const PrismQuery& near, double x, double y, double z, double dir_x,
                  double dir_y, double elevation, double max_range)
 {
-  const double cos_e = std::cos(elevation);
-  const double tan_e = std::tan(elevation);
+  return castRay3DTrig(scene, near, x, y, z, dir_x, dir_y, std::cos(elevation), std::tan(elevation), max_range);
+}
+
+RayHit castRay3DTrig(const Scene25D& scene, const PrismQuery& near, double x, double y, double z, double dir_x,
+                     double dir_y, double cos_e, double tan_e, double max_range)
+{
   const double max_h = max_range * cos_e;  // horizontal reach [m]
   const double wall_top = scene.wallHeight();
 
@@ -247,11 +276,74 @@ LidarPattern::LidarPattern(const LidarSpec& spec) : spec_(spec)
   w2_ = kTwoPi * spec.rate * 76.39320225002103;
   e_mid_ = 0.5 * (spec.max_elevation + spec.min_elevation);
   e_half_ = 0.5 * (spec.max_elevation - spec.min_elevation);
+  step1_c_ = std::cos(w1_ * dt_);
+  step1_s_ = std::sin(w1_ * dt_);
+  step2_c_ = std::cos(w2_ * dt_);
+  step2_s_ = std::sin(w2_ * dt_);
+  steph_c_ = std::cos(kTwoPi * spec.rate * dt_);
+  steph_s_ = std::sin(kTwoPi * spec.rate * dt_);
+  for (int j = 0; j < 4; ++j)
+  {
+    phase_c_[j] = std::cos(kTwoPi * kGolden * j);
+    phase_s_[j] = std::sin(kTwoPi * kGolden * j);
+  }
+  cos_mid_ = std::cos(e_mid_);
+  sin_mid_ = std::sin(e_mid_);
+}
+
+void LidarPattern::seek(uint64_t n, Cursor& c) const
+{
+  const double t = static_cast<double>(n) * dt_;
+  const double a1 = std::fmod(w1_ * t, kTwoPi), a2 = std::fmod(w2_ * t, kTwoPi);
+  const double head = kTwoPi * std::fmod(spec_.rate * t, 1.0);
+  c.n = n;
+  c.c1 = std::cos(a1);
+  c.s1 = std::sin(a1);
+  c.c2 = std::cos(a2);
+  c.s2 = std::sin(a2);
+  c.ch = std::cos(head);
+  c.sh = std::sin(head);
+}
+
+void LidarPattern::next(Cursor& c) const
+{
+  auto turn = [](double& re, double& im, double sc, double ss) {
+    const double r = re * sc - im * ss;
+    im = im * sc + re * ss;
+    re = r;
+  };
+  turn(c.c1, c.s1, step1_c_, step1_s_);
+  turn(c.c2, c.s2, step2_c_, step2_s_);
+  turn(c.ch, c.sh, steph_c_, steph_s_);
+  ++c.n;
+}
+
+void LidarPattern::unitDirection(const Cursor& c, double& cos_az, double& sin_az, double& cos_el, double& sin_el) const
+{
+  const int j = static_cast<int>(c.n & 3u);
+  const double pc = phase_c_[j], ps = phase_s_[j];
+  const double cos_a1 = c.c1 * pc - c.s1 * ps, sin_a1 = c.s1 * pc + c.c1 * ps;
+  const double cos_a2 = c.c2 * pc - c.s2 * ps, sin_a2 = c.s2 * pc + c.c2 * ps;
+  const double r = 0.5 * e_half_;
+  double sd, cd, se, ce;
+  sinCosSmall(r * (cos_a1 + cos_a2), sd, cd);  // the azimuth's deflection
+  sinCosSmall(r * (sin_a1 - sin_a2), se, ce);  // the elevation's
+  // the head turned by j quarter turns
+  double hc = c.ch, hs = c.sh;
+  for (int q = 0; q < j; ++q)
+  {
+    const double tmp = hc;
+    hc = -hs;
+    hs = tmp;
+  }
+  cos_az = hc * cd - hs * sd;
+  sin_az = hs * cd + hc * sd;
+  cos_el = cos_mid_ * ce - sin_mid_ * se;
+  sin_el = sin_mid_ * ce + cos_mid_ * se;
 }
 
 void LidarPattern::direction(uint64_t n, double& azimuth, double& elevation) const
 {
-  constexpr double kGolden = 0.6180339887498949;
   const int channel = static_cast<int>(n & 3u);
   const double t = static_cast<double>(n) * dt_;
   const double phase = kTwoPi * kGolden * channel;
@@ -275,6 +367,7 @@ LidarScanner::LidarScanner(const LidarSpec& spec, double mount_x, double mount_y
       mount_y_(mount_y),
       mount_z_(mount_z),
       mount_yaw_(mount_yaw),
+      start_(start),
       frame_start_(start),
       next_point_(0)
 {
@@ -297,25 +390,39 @@ size_t LidarScanner::advance(const Scene25D& scene, const PrismQuery& near, doub
   const double dt = 1.0 / (spec_.rate * spec_.points_per_frame);
   const double period = 1.0 / spec_.rate;
   const double span = t1 - t0;
-  double dtheta = p1.theta - p0.theta;
-  dtheta = std::remainder(dtheta, kTwoPi);
+  const double dtheta = std::remainder(p1.theta - p0.theta, kTwoPi);
   size_t cast = 0;
+  bool started = false;
+  LidarPattern::Cursor cursor;
+  double rc = 1.0, rs = 0.0;          // e^{i robot heading} at the point's time
+  double turn_c = 1.0, turn_s = 0.0;  // its turn per point
+  const double yc = std::cos(mount_yaw_), ys = std::sin(mount_yaw_);
   for (;;)
   {
     const double t = frame_start_ + in_frame_ * dt;
     if (t >= t1) break;
     const double alpha = span > 0.0 ? std::min(1.0, std::max(0.0, (t - t0) / span)) : 1.0;
+    if (!started)
+    {
+      // Exact at the step's first point, then turned point by point (no trigonometry per point).
+      pattern_.seek(next_point_, cursor);
+      const double heading = p0.theta + alpha * dtheta;
+      rc = std::cos(heading);
+      rs = std::sin(heading);
+      const double per_point = span > 0.0 ? dtheta * dt / span : 0.0;
+      turn_c = std::cos(per_point);
+      turn_s = std::sin(per_point);
+      started = true;
+    }
     const double rx = p0.x + alpha * (p1.x - p0.x);
     const double ry = p0.y + alpha * (p1.y - p0.y);
-    const double rth = p0.theta + alpha * dtheta;
-    const double c = std::cos(rth), s = std::sin(rth);
-    const double sx = rx + c * mount_x_ - s * mount_y_;
-    const double sy = ry + s * mount_x_ + c * mount_y_;
-    double az = 0.0, el = 0.0;
-    pattern_.direction(next_point_, az, el);
-    const double heading = rth + mount_yaw_ + az;
-    const RayHit hit =
-        castRay3D(scene, near, sx, sy, mount_z_, std::cos(heading), std::sin(heading), el, spec_.range_max);
+    const double sx = rx + rc * mount_x_ - rs * mount_y_;  // the lidar in the world
+    const double sy = ry + rs * mount_x_ + rc * mount_y_;
+    const double lc = rc * yc - rs * ys, ls = rs * yc + rc * ys;  // its heading
+    double ca = 1.0, sa = 0.0, ce = 1.0, se = 0.0;
+    pattern_.unitDirection(cursor, ca, sa, ce, se);
+    const double dir_x = lc * ca - ls * sa, dir_y = ls * ca + lc * sa;
+    const RayHit hit = castRay3DTrig(scene, near, sx, sy, mount_z_, dir_x, dir_y, ce, se / ce, spec_.range_max);
     ++cast;
     if (hit.surface != Surface::kNone)
     {
@@ -325,17 +432,20 @@ size_t LidarScanner::advance(const Scene25D& scene, const PrismQuery& near, doub
         range = std::round(range / spec_.range_quantization) * spec_.range_quantization;
       if (range >= spec_.range_min && range <= spec_.range_max)
       {
-        const double ce = std::cos(el);
         LidarPoint p;
-        p.x = static_cast<float>(range * ce * std::cos(az));
-        p.y = static_cast<float>(range * ce * std::sin(az));
-        p.z = static_cast<float>(range * std::sin(el));
+        p.x = static_cast<float>(range * ce * ca);
+        p.y = static_cast<float>(range * ce * sa);
+        p.z = static_cast<float>(range * se);
         p.intensity = hit.intensity;
         p.time = static_cast<float>(in_frame_ * dt);
         frame_.points.push_back(p);
       }
     }
     ++next_point_;
+    pattern_.next(cursor);
+    const double r = rc * turn_c - rs * turn_s;
+    rs = rs * turn_c + rc * turn_s;
+    rc = r;
     if (++in_frame_ == spec_.points_per_frame)
     {
       frame_.stamp = frame_start_;
