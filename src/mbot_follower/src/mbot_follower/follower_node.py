@@ -54,14 +54,14 @@ import traceback
 
 import rospy
 
-from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point
+from mbot_common.geometry import Pose2D, Twist2D, compose, normalize_angle, relative, transform_point, yaw_of
 from mbot_follower.control_laws import (CommandFilter, ControlInput, ControllerConfig, GiveWay, detour,
                                         make_control_law, safety_filter, scan_points, way_blocked)
 from mbot_follower.fleet_io import (CachedParams, RobotTfListener, StalePose, assignment_from_msg, lookup_pose,
                                     quiet_at_shutdown, stale_scan)
 from mbot_follower.free_space import FreeSpace
 from mbot_follower.merge import merge_target, robot_ahead
-from mbot_follower.trail import Trail, path_pose, path_slot
+from mbot_follower.trail import LeaderTrail, Trail, path_pose, path_slot
 
 #: Private parameters of the node itself (the control law's are ControllerConfig's fields).
 NODE_PARAMS = {
@@ -85,6 +85,8 @@ NODE_PARAMS = {
 #: Parameters that take effect only at start (the control timer's period).
 RESTART_PARAMS = ("rate", "tf_source")
 HOLD_STATES = ("IDLE", "ABORTED")
+TF_CACHE = 5.0      # [s] of poses the node's tf buffer keeps (its cache_time)
+POSE_PERIOD = 0.02  # [s] between a robot's poses (the simulator's odometry at 50 Hz)
 
 
 class FollowerController(object):
@@ -139,8 +141,9 @@ class FollowerController(object):
         self.free_space = None
         self._map_msg = None               # kept to apply a new ~map_clearance
         self.trail = Trail()               # the leader's path, for a blocked slot (trail mode)
-        self.path = Trail()                # the leader's path since the assignment (path slots)
-        self._path_pending = False         # start self.path at the leader's next pose
+        self.path = LeaderTrail()          # the leader's path since the assignment (path slots)
+        self._path_pending = False         # start self.path from the tf buffer at the next cycle
+        self._path_since = None            # the assignment's stamp (rospy.Time)
         self._leader_map = None            # the leader's newest map pose
         self._reference = None
         self.leader_twist = Twist2D(0.0, 0.0, 0.0)
@@ -213,14 +216,18 @@ class FollowerController(object):
     # --- inputs -------------------------------------------------------------------------------
 
     def _on_assignment(self, msg):
-        self._on_assignment_data(assignment_from_msg(msg))
+        self._on_assignment_data(assignment_from_msg(msg), msg.header.stamp)
 
-    def _on_assignment_data(self, assignment):
+    def _on_assignment_data(self, assignment, stamp=None):
+        """`stamp`: the assignment's time (its header); None or 0 (no stamp): when it arrived."""
+        if stamp is None or stamp.is_zero():
+            stamp = rospy.Time.now()
         with self.lock:
-            self._take_assignment(assignment)
+            self._take_assignment(assignment, stamp)
 
-    def _take_assignment(self, assignment):
+    def _take_assignment(self, assignment, stamp):
         self.assignment = assignment
+        self._path_since = stamp
         reference = self.assignment.follows.get(self.robot) or self.assignment.leader
         if self._reference != reference:
             self._reference = reference
@@ -403,10 +410,48 @@ class FollowerController(object):
                 return
         self.trail.add(leader_map.x, leader_map.y)
         if self._path_pending:
-            self.path.start(leader_map.x, leader_map.y, leader_map.theta)
-            self._path_pending = False
-        self.path.add(leader_map.x, leader_map.y)
+            self._path_pending = not self._start_path(a.leader)
+        if not self._path_pending:
+            self.path.follow(leader_map.x, leader_map.y, leader_map.theta)
         self._leader_map = leader_map
+
+    def _start_path(self, leader):
+        """Start the leader's path of the assignment as the coordinator and the metrics collector
+        do (trail.LeaderTrail): at the leader's pose at the assignment's stamp, then its poses
+        since, from the tf buffer (an assignment that arrives late misses none of the path, also
+        round a corner). Without a pose at the stamp (the leader's poses came in only later) it
+        starts at the first one the buffer has after it. False while the buffer has no pose of
+        the leader at or after the stamp yet: it waits for one."""
+        import tf2_ros
+
+        frame = "%s/base_link" % leader
+        errors = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+
+        def pose_at(t):
+            try:
+                tf = self.tf_buffer.lookup_transform("map", frame, t)
+            except errors:
+                return None
+            return tf.transform.translation.x, tf.transform.translation.y, yaw_of(tf.transform.rotation)
+
+        since = self._path_since
+        try:
+            newest = self.tf_buffer.lookup_transform("map", frame, rospy.Time(0)).header.stamp
+        except errors:
+            return False
+        if newest < since:
+            return False
+        self.path.restart(since.to_sec(), pose_at(since))
+        # the poses since, at the rate they come in (the collector takes each one); no further
+        # back than the buffer keeps (an assignment of long ago starts at its oldest pose)
+        step = rospy.Duration(POSE_PERIOD)
+        t = rospy.Time.from_sec(max(since.to_sec(), newest.to_sec() - TF_CACHE)) + step
+        while t < newest:
+            pose = pose_at(t)
+            if pose is not None:
+                self.path.follow(*pose)
+            t += step
+        return True
 
     def _slot_frame(self, a, reference, pose, ref_map):
         """(frame in the map, the robot's pose in it, its slot (x, y) in it, the frame's twist)
@@ -595,6 +640,7 @@ class FollowerController(object):
         msg.robot = self.robot
         msg.active = mode in ("slot", "merge", "detour", "trail", "safety_stop", "give_way")
         msg.mode = mode
+        msg.controller = self.params["controller"]
         if pose_stamp is not None:
             msg.pose_stamp = pose_stamp
         msg.slot_error.x, msg.slot_error.y = err

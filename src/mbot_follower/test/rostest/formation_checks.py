@@ -6,7 +6,8 @@ from the simulator's ground truth (not from what the coordinator says about itse
 The check is chosen by the private parameter ~check (one .test file per check):
   triangle  - the triangle drives to (5, 0) via /simulation/target_pose: slot RMS while moving
               < 0.15 m, ARRIVED, no contact (~formation, ~topology: another shape, a chain;
-              ~omni: the followers are omni robots and must drive sideways too)
+              ~omni: the followers are omni robots and must drive sideways too; ~controller:
+              every FollowerState of the followers names this control law)
   obstacle  - a box appears in the leader's way while NAVIGATING: pause, go around, ARRIVED, no contact
   switch    - switch to `line` while moving: the line is reached; then to `column`: the leader
               drives faster until the column is there, then at its usual speed again (a switch
@@ -96,7 +97,9 @@ class FormationChecks(unittest.TestCase):
         p = self.probe
         self.assertEqual(p.state(), "IDLE")
         sideways = self.record_sideways_commands() if rospy.get_param("~omni", False) else None
+        laws = self.record_controllers()
         self.drive_and_arrive(5.0, 0.0)
+        self.check_controllers(laws)
         if sideways is not None:   # omni followers run the omni law: they drive sideways too
             rospy.loginfo("triangle: largest sideways command per follower %s", sideways)
             for robot, largest in sideways.items():
@@ -133,6 +136,31 @@ class FormationChecks(unittest.TestCase):
             largest[robot] = 0.0
             rospy.Subscriber("/%s/cmd_vel" % robot, Twist, on_cmd, callback_args=robot, queue_size=50)
         return largest
+
+    def record_controllers(self):
+        """{follower: {law named in its FollowerState: [modes of those cycles]}} from now on."""
+        from mbot_msgs.msg import FollowerState
+
+        laws = {robot: {} for robot in robots_param()[1:]}
+
+        def on_state(msg, robot):
+            laws[robot].setdefault(msg.controller, []).append(msg.mode)
+
+        for robot in laws:
+            rospy.Subscriber("/%s/follower_controller/state" % robot, FollowerState, on_state, callback_args=robot,
+                             queue_size=50)
+        return laws
+
+    def check_controllers(self, laws):
+        """With ~controller set: each follower's every state named it, and it drove to its slot
+        (mode slot) in many of those cycles: the law ran, not only its name."""
+        expected = rospy.get_param("~controller", "")
+        if not expected:
+            return
+        for robot, seen in laws.items():
+            rospy.loginfo("%s: states per control law %s", robot, {law: len(modes) for law, modes in seen.items()})
+            self.assertEqual(set(seen), {expected}, "%s's states name %s" % (robot, sorted(seen)))
+            self.assertGreater(seen[expected].count("slot"), 200, "%s: too few cycles in mode slot" % robot)
 
     def check_view_frame(self):
         """The coordinator's `fleet` frame (rviz follows it) is the middle of the resting fleet."""

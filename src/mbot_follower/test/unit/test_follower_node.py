@@ -342,3 +342,20 @@ def test_the_consensus_law_runs_in_the_node_and_acts_only_on_a_neighbours_error(
     assert commands["consensus", 0.0] == pytest.approx(commands["slot_tracking", 0.0], abs=1e-9)
     assert commands["slot_tracking", 0.5] == pytest.approx(commands["slot_tracking", 0.0], abs=1e-9)
     assert commands["consensus", 0.5] != pytest.approx(commands["consensus", 0.0], abs=1e-3)
+
+
+def test_the_state_names_the_control_law_that_ran_each_cycle(clock):
+    """FollowerState.controller is the node's ~controller of that cycle, also after rosparam set."""
+    n = node(clock)
+    n._on_assignment_data(TRIANGLE)
+    n._cycle(None)
+    assert (last_mode(n), n.state_pub.messages[-1].controller) == ("slot", "slot_tracking")
+    n._read_params({"controller": "consensus"})
+    clock.set(100.05)
+    move(n, clock.t)
+    n._on_scan(scan(clock.t))
+    n._cycle(None)
+    assert (last_mode(n), n.state_pub.messages[-1].controller) == ("slot", "consensus")
+    n.assignment = None
+    n._cycle(None)                                   # held still: the law in force all the same
+    assert (last_mode(n), n.state_pub.messages[-1].controller) == ("idle", "consensus")

@@ -1,6 +1,7 @@
 """One definition of the leader's path (trail.LeaderTrail): it starts at the leader's pose at the
-assignment's time, whoever builds it (coordinator, metrics collector, fleet probe) and however
-late the assignment reaches them, so a column's slots lie in the same places for all of them."""
+assignment's time, whoever builds it (coordinator, metrics collector, fleet probe, the follower
+node itself) and however late the assignment reaches them, so a column's slots lie in the same
+places for all of them."""
 import math
 from unittest import mock
 
@@ -103,8 +104,65 @@ def probe_trail(monkeypatch):
     return probe.trail
 
 
-def test_coordinator_collector_and_probe_put_a_columns_slots_on_the_same_path(monkeypatch):
-    trails = {"coordinator": coordinator_trail(), "collector": collector_trail(), "probe": probe_trail(monkeypatch)}
+def follower_trail(monkeypatch, arrives, assigned=ASSIGNED):
+    """Follower a's node, built without a master (as test_follower_node.py does): the leader's and
+    its own poses in its tf buffer at 50 Hz, a cycle every 0.05 s; the assignment (stamped
+    `assigned`) reaches it at `arrives` [s]."""
+    import tf2_ros
+    from geometry_msgs.msg import TransformStamped, Twist
+    from mbot_msgs.msg import FollowerState
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import LaserScan
+
+    from mbot_follower import follower_node
+
+    class Recorder(object):
+        def publish(self, msg):
+            pass
+
+    monkeypatch.setattr(follower_node.rospy, "Subscriber", mock.Mock())
+    rospy.rostime.set_rostime_initialized(True)
+    n = follower_node.FollowerController.__new__(follower_node.FollowerController)
+    n.robot = "a"
+    n._init_state()
+    n.params["pose_wait"] = 0.0
+    n._msg = {"Twist": Twist, "FollowerState": FollowerState, "Odometry": Odometry}
+    n.cmd_pub, n.state_pub = Recorder(), Recorder()
+    n.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(5.0), debug=False)
+    n._param_cache = type("Cache", (), {"values": lambda self: {}})()
+    n._on_status(type("Status", (), {"state": "NAVIGATING", "paused": False})())
+
+    def place(t):
+        head = leader_at(t)
+        for child, pose in (("L", head), ("a", Pose2D(head.x - 1.0, head.y, head.theta))):
+            tf = TransformStamped()
+            tf.header.stamp = rospy.Time.from_sec(t)
+            tf.header.frame_id = "map"
+            tf.child_frame_id = "%s/base_link" % child
+            tf.transform.translation.x, tf.transform.translation.y = pose.x, pose.y
+            tf.transform.rotation.z, tf.transform.rotation.w = math.sin(pose.theta / 2), math.cos(pose.theta / 2)
+            n.tf_buffer.set_transform(tf, "test")
+
+    column = Assignment("L", "column", 1.0, COLUMN, {r: "L" for r in COLUMN}, True)
+    for t in stamps(50.0):
+        place(t)
+        rospy.rostime._set_rostime(rospy.Time.from_sec(t))
+        if abs(t - arrives) < 1e-9:
+            n._on_assignment_data(column, rospy.Time.from_sec(assigned))
+        if round(t * 50) % 5 == 0:   # the node's cycles: every 0.1 s here
+            scan = LaserScan()
+            scan.header.stamp = rospy.Time.from_sec(t)
+            scan.angle_min, scan.angle_increment, scan.range_max = -math.pi, 2 * math.pi / 360, 8.0
+            scan.ranges = [math.inf] * 360
+            n._on_scan(scan)
+            n._cycle(None)
+    assert n.cycle_failures == 0
+    return n.path
+
+
+def test_coordinator_collector_probe_and_follower_put_a_columns_slots_on_the_same_path(monkeypatch):
+    trails = {"coordinator": coordinator_trail(), "collector": collector_trail(), "probe": probe_trail(monkeypatch),
+              "follower": follower_trail(monkeypatch, ASSIGNED + 0.3)}
     head = leader_at(END)
     start = leader_at(ASSIGNED)
     for who, trail in trails.items():
@@ -119,3 +177,24 @@ def test_coordinator_collector_and_probe_put_a_columns_slots_on_the_same_path(mo
     # cut the corner by a few mm); 2 m behind is before the path's start (0.5, 0), straight on
     assert slot_pose(head, (-1.0, 0.0), trails["probe"])[:2] == pytest.approx((0.5, 0.0), abs=0.02)
     assert slot_pose(head, (-2.0, 0.0), trails["probe"])[:2] == pytest.approx((-0.5, 0.0), abs=0.02)
+
+
+def test_a_follower_whose_assignment_arrives_after_the_corner_has_the_path_round_it(monkeypatch):
+    """The assignment of 1.8 s (the leader at (0.9, 0), 0.1 m before the corner) reaches follower
+    a only at 2.4 s, 0.2 m past it: its path still starts at (0.9, 0) and turns the corner, as the
+    collector's, from the poses in its tf buffer (a path begun where the leader was when the
+    assignment came put the slots on the straight line behind (1, 0.2), 0.4 m off)."""
+    assigned = 1.8
+    collector = MetricsCollector()
+    collector.on_assignment(assigned, Assignment("L", "column", 1.0, COLUMN, {r: "L" for r in COLUMN}, True))
+    collector.on_status(assigned, "NAVIGATING", "goal", [])
+    for t in stamps(50.0, END + 0.02):
+        collector.on_pose("L", t, *leader_at(t))
+    follower = follower_trail(monkeypatch, 2.4, assigned)
+    assert follower.since == assigned
+    assert follower.point_behind(follower.length()) == pytest.approx((0.9, 0.0), abs=1e-9)
+    head = leader_at(END)
+    # not -0.5, the corner itself: there points 5 cm apart cut it by up to 1.3 cm, as their phase falls
+    for offset in ((-0.3, 0.0), (-0.8, 0.0), (-1.0, 0.3), (-2.0, 0.0)):
+        slot, truth = slot_pose(head, offset, follower), slot_pose(head, offset, collector._trail)
+        assert math.hypot(slot.x - truth.x, slot.y - truth.y) < 0.01, offset
