@@ -2,7 +2,10 @@
 
     scripts/bench sim [--json FILE]   simulator real-time factor for N robots (median of
                                       --sim-runs runs, default 3; stepping alone and the whole
-                                      run with loading and placing), ray casting rate
+                                      run with loading and placing), ray casting rate; the 3D
+                                      lidar: points per second of its caster (raycast_bench) and
+                                      the real-time factor with 1 and 4 lidar robots (sim_bench
+                                      --lidar; rtf_cpu by the process's CPU time)
     scripts/bench nav [--json FILE]   global plan time, length and cost (the shipped settings,
                                       one plan per pair; fastest of 5 beside it), DWA cycle time
                                       (defaults and the shipped nav_dwa.yaml), and the seeded
@@ -104,6 +107,25 @@ def spread(values):
             "runs": len(values)}
 
 
+# 3D lidar runs: robots, each with the default lidar (20000 points at 10 Hz), in bench_room.
+SIM_LIDAR_RUNS = [(1, 60.0), (4, 20.0)]
+
+
+def bench_sim_lidar(raycast, runs):
+    """The 3D lidar's figures: raycast_bench's caster alone, sim_bench's whole simulation."""
+    out = {"points_per_second": raycast["lidar"]["points_per_second"],
+           "cpu_points_per_second": raycast["lidar"]["cpu_points_per_second"], "rtf": {}, "rtf_cpu": {},
+           "rays_per_cpu_second": {}}
+    for robots, seconds in SIM_LIDAR_RUNS:
+        results = [run_json([program("mbot_sim", "sim_bench"), "--robots", str(robots), "--lidar", str(robots),
+                             "--map", os.path.join(ROOT, "maps", "bench_room.yaml"), "--seconds", str(seconds)])
+                   for _ in range(runs)]
+        out["rtf"][str(robots)] = round(median([r["rtf"] for r in results]), 2)
+        out["rtf_cpu"][str(robots)] = round(median([r["rtf_cpu"] for r in results]), 2)
+        out["rays_per_cpu_second"][str(robots)] = round(median([r["lidar_rays_per_cpu_second"] for r in results]))
+    return out
+
+
 def bench_sim(runs=3):
     rays = run_json([program("mbot_sim", "raycast_bench")])
     rtf = {}
@@ -120,6 +142,7 @@ def bench_sim(runs=3):
         all_runs[str(robots)] = results
     # rtf: the stepping alone (median run); rtf_with_loading: whole runs, loading and placing included.
     return {"rtf": rtf, "rtf_with_loading": with_loading, "rays_per_second": rays["rays_per_second"],
+            "lidar": bench_sim_lidar(rays, runs),
             "sim_runs": details, "sim_runs_all": all_runs}
 
 
@@ -264,6 +287,13 @@ def print_table(result):
             w = result["rtf_with_loading"][n]
             print("  %-8s %12.2f %12.2f (%.2f-%.2f)" % (n, x, w["median"], w["min"], w["max"]))
         print("  ray casting: %.1f million rays/s" % (result["rays_per_second"] / 1e6))
+        lidar = result.get("lidar")
+        if lidar:
+            print("  3D lidar caster: %.1f million points/s (%.1f per CPU s)" % (
+                lidar["points_per_second"] / 1e6, lidar["cpu_points_per_second"] / 1e6))
+            for n in lidar["rtf"]:
+                print("  %s lidar robots (20000 points at 10 Hz each): %.1fx real time (%.1fx by CPU time)" % (
+                    n, lidar["rtf"][n], lidar["rtf_cpu"][n]))
     if "plan_ms" in result:
         print("\nGlobal planner (A*, nav_move_base.yaml's settings, the benchmark inputs, planning only, one thread)")
         print("  %-8s %20s %20s %12s %10s %9s" % ("grid", "one plan p50/p95 ms", "fastest of 5 ms", "mean cells",

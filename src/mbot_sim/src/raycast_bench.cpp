@@ -11,12 +11,19 @@
  * "rays_per_second" (wall time, std::chrono::steady_clock), "cpu_rays_per_second" uses the
  * process CPU time: on a machine busy with other work it shows the speed of the code itself.
  *
+ * Then the 3D lidar (lidar3d.h): a Mid-360-like lidar (defaults: 20000 points per 0.1 s frame,
+ * 40 m, noise and quantization on) riding a wandering robot through the room (2.5 m walls, the
+ * 10 robots as 0.3 m prisms, two boxes), cast step by step (0.01 s) as the simulator does:
+ * "lidar": {"points_per_second", "cpu_points_per_second", ...}, rays cast per second.
+ *
  *   raycast_bench [--seconds S]   S: timed work per scenario [s], default 2 (at least 1)
+ *   raycast_bench --lidar-only    only the 3D lidar scenario (for perf record)
  *   raycast_bench --scans N       only the room, exactly N scans (rounded up to whole frames):
  *                                 the same work on every run, for instruction counts, e.g.
  *     valgrind --tool=callgrind --toggle-collect='mbot_sim::castScan*' raycast_bench --scans 2000
  *                                 (instructions per ray = the collected count / (N * 360))
  */
+#include "mbot_sim/lidar3d.h"
 #include "mbot_sim/raycast.h"
 
 #include <algorithm>
@@ -251,21 +258,104 @@ Result run(Scenario& sc, int scans_per_frame, double min_seconds, long exact_sca
   res.rebuild_us = 1e6 * rebuild_s / frames;
   return res;
 }
+struct LidarResult
+{
+  double points_per_second = 0.0;  ///< rays cast per wall second
+  double cpu_points_per_second = 0.0;
+  double returns_fraction = 0.0;  ///< points kept (hits within range) per ray
+  double seconds = 0.0;
+  long rays = 0;
+};
+
+/// The 3D lidar on robot 0 of the room scenario, stepped at 0.01 s as the simulator does: each
+/// step rebuilds the prisms (the robots and two boxes), picks those in reach and casts the
+/// points of the step from poses interpolated over it. Timed: the whole step.
+LidarResult runLidar(Scenario& sc, double min_seconds)
+{
+  using Clock = std::chrono::steady_clock;
+  mbot_sim::Scene25D scene(&sc.grid, 2.5);
+  mbot_sim::LidarSpec spec;
+  spec.range_noise = 0.02;
+  spec.range_quantization = 0.001;
+  mbot_sim::LidarScanner lidar(spec, -0.06, 0.0, 0.26, 0.0, 0.0);
+  mbot_sim::PrismQuery near;
+  std::mt19937 rng(7);
+  std::vector<mbot_sim::LidarFrame> frames;
+  const double dt = 0.01;
+  double t = 0.0, elapsed = 0.0, cpu = 0.0;
+  long rays = 0, kept = 0;
+  const Robot& me = sc.robots[0];
+  mbot_sim::PlanarPose last{me.x, me.y, me.heading};
+  while (elapsed < min_seconds)
+  {
+    sc.moveRobots();  // one motion per kFrameDt (0.1 s): ten steps, poses interpolated
+    const mbot_sim::PlanarPose next{me.x, me.y, me.heading};
+    for (int k = 1; k <= 10; ++k)
+    {
+      const double f = k / 10.0;
+      const double turn = std::remainder(next.theta - last.theta, 2.0 * M_PI);
+      const mbot_sim::PlanarPose p0{last.x + (f - 0.1) * (next.x - last.x), last.y + (f - 0.1) * (next.y - last.y),
+                                    last.theta + (f - 0.1) * turn};
+      const mbot_sim::PlanarPose p1{last.x + f * (next.x - last.x), last.y + f * (next.y - last.y),
+                                    last.theta + f * turn};
+      const auto start = Clock::now();
+      const std::clock_t cpu_start = std::clock();
+      scene.clearPrisms();
+      for (size_t i = 0; i < sc.robots.size(); ++i)
+      {
+        mbot_sim::Prism prism;
+        prism.x = sc.robots[i].x;
+        prism.y = sc.robots[i].y;
+        prism.radius = kRobotRadius;
+        prism.height = 0.3;
+        prism.owner = static_cast<int>(i);
+        scene.addPrism(prism);
+      }
+      mbot_sim::Prism box;
+      box.is_box = true;
+      box.half_length = 0.4;
+      box.half_width = 0.3;
+      box.height = 0.8;
+      box.x = 5.0, box.y = 5.0;
+      scene.addPrism(box);
+      box.x = 17.0, box.y = 10.0, box.yaw = 0.5;
+      scene.addPrism(box);
+      near.prepare(scene, p1.x, p1.y, spec.range_max + 1.0, 0);
+      frames.clear();
+      rays += static_cast<long>(lidar.advance(scene, near, t, p0, t + dt, p1, rng, frames));
+      for (const auto& frame : frames) kept += static_cast<long>(frame.points.size());
+      elapsed += std::chrono::duration<double>(Clock::now() - start).count();
+      cpu += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+      t += dt;
+    }
+    last = next;
+  }
+  LidarResult res;
+  res.points_per_second = rays / elapsed;
+  res.cpu_points_per_second = rays / cpu;
+  res.returns_fraction = static_cast<double>(kept) / rays;
+  res.seconds = elapsed;
+  res.rays = rays;
+  return res;
+}
 }  // namespace
 
 int main(int argc, char** argv)
 {
   double seconds = 2.0;
   long exact_scans = 0;
+  bool lidar_only = false;
   for (int i = 1; i < argc; ++i)
   {
     if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
       seconds = std::max(1.0, std::atof(argv[++i]));
     else if (std::strcmp(argv[i], "--scans") == 0 && i + 1 < argc)
       exact_scans = std::max(1L, std::atol(argv[++i]));
+    else if (std::strcmp(argv[i], "--lidar-only") == 0)
+      lidar_only = true;
     else
     {
-      std::fprintf(stderr, "usage: %s [--seconds S | --scans N]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--seconds S | --scans N | --lidar-only]\n", argv[0]);
       return 2;
     }
   }
@@ -274,6 +364,21 @@ int main(int argc, char** argv)
   Canvas room(kRoomSize, kRoomSize);
   room.room(0.0, 0.0);
   Scenario small(room, 10, 1);
+  auto print_lidar = [](const LidarResult& l) {
+    std::printf(
+        "\"lidar\": {\"points_per_second\": %.0f, \"cpu_points_per_second\": %.0f, \"returns_fraction\": %.3f, "
+        "\"rays\": %ld, \"seconds\": %.3f, \"points_per_frame\": 20000, \"rate\": 10}",
+        l.points_per_second, l.cpu_points_per_second, l.returns_fraction, l.rays, l.seconds);
+  };
+  if (lidar_only)
+  {
+    runLidar(small, 0.2);
+    const LidarResult l = runLidar(small, seconds);
+    std::printf("{");
+    print_lidar(l);
+    std::printf("}\n");
+    return 0;
+  }
   if (exact_scans > 0)
   {
     const Result r = run(small, 10, 0.0, exact_scans);
@@ -292,6 +397,9 @@ int main(int argc, char** argv)
     for (int i = 0; i < 3; ++i) big.room(i * kRoomSize, j * kRoomSize);
   Scenario large(big, 1000, 2);
   const Result b = run(large, 100, seconds);
+  Scenario lidar_room(room, 10, 3);
+  runLidar(lidar_room, 0.2);
+  const LidarResult l = runLidar(lidar_room, seconds);
 
   // One JSON line (scripts/bench reads the last line starting with '{').
   std::printf("{\"rays_per_second\": %.0f, \"beams\": %d, \"range_max\": %.1f, ", a.rays_per_second, kBeams, kRangeMax);
@@ -306,7 +414,9 @@ int main(int argc, char** argv)
   std::printf(
       "\"large_map\": {\"rays_per_second\": %.0f, \"cpu_rays_per_second\": %.0f, "
       "\"scans\": %ld, \"seconds\": %.3f, \"map\": \"room tiled 3x3, 60x60 m\", "
-      "\"robots\": 1000, \"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f}}\n",
+      "\"robots\": 1000, \"returns_fraction\": %.3f, \"shape_rebuild_us\": %.2f}, ",
       b.rays_per_second, b.cpu_rays_per_second, b.scans, b.seconds, b.returns_fraction, b.rebuild_us);
+  print_lidar(l);
+  std::printf("}\n");
   return 0;
 }

@@ -10,6 +10,12 @@
  *        rtf_with_loading is the figure of a whole run, as Stage's benchmark times its runs.)
  *
  *   sim_bench --robots 100 --map maps/bench_room.yaml --seconds 20
+ *   sim_bench --robots 10 --lidar 10 --seconds 20   the first 10 robots also carry the 3D lidar
+ *                                                   (world file defaults: 20000 points at 10 Hz)
+ *
+ * With --lidar K the line also has "lidar_robots": K, "lidar_rays_per_second" (3D rays cast per
+ * wall second of stepping), "lidar_rays_per_cpu_second" and "lidar_points" (points in the
+ * frames handed to the listener, as stage_node would publish them).
  *
  * Every robot wanders: it drives at 0.4 m/s and, when its own scan shows an obstacle ahead,
  * stops and turns towards the freer side until the way is clear. Robots start at random free
@@ -47,12 +53,13 @@ struct Options
   double physics_step = 0.01;  ///< [s]
   double speed = 0.4;          ///< [m/s] wander speed
   double clearance = 0.2;      ///< [m] free space around each start pose, beyond the footprint
+  int lidar = 0;               ///< robots with the 3D lidar (the first ones)
 };
 
 void usage()
 {
   std::cerr << "usage: sim_bench [--robots N] [--map MAP.yaml] [--seconds S] [--seed K] [--model mbot]\n"
-               "                 [--description MBOT_DESCRIPTION_DIR] [--physics-step DT]\n";
+               "                 [--description MBOT_DESCRIPTION_DIR] [--physics-step DT] [--lidar K]\n";
 }
 
 Options parse(int argc, char** argv)
@@ -86,6 +93,8 @@ Options parse(int argc, char** argv)
         o.description = value();
       else if (arg == "--physics-step")
         o.physics_step = std::stod(value());
+      else if (arg == "--lidar")
+        o.lidar = std::stoi(value());
       else if (arg == "--help" || arg == "-h")
       {
         usage();
@@ -104,9 +113,9 @@ Options parse(int argc, char** argv)
       std::exit(2);
     }
   }
-  if (o.robots < 1 || !(o.seconds > 0.0))
+  if (o.robots < 1 || !(o.seconds > 0.0) || o.lidar < 0 || o.lidar > o.robots)
   {
-    std::cerr << "sim_bench: expected --robots >= 1 and --seconds > 0\n";
+    std::cerr << "sim_bench: expected --robots >= 1, --seconds > 0 and --lidar in [0, robots]\n";
     std::exit(2);
   }
   return o;
@@ -155,6 +164,10 @@ public:
     }
     world_.setCommand(robot, cmd);
   }
+
+  void onPointCloud(int /*robot*/, const mbot_sim::LidarFrame& frame) override { points += frame.points.size(); }
+
+  unsigned long long points = 0;  ///< 3D lidar points handed over
 
 private:
   mbot_sim::World& world_;
@@ -218,6 +231,13 @@ int main(int argc, char** argv)
       }
     }
 
+    for (int id : world.robotIds())
+    {
+      if (id >= opt.lidar) break;
+      mbot_common::LidarConfig lidar;
+      lidar.enabled = true;
+      world.setLidar(id, lidar);
+    }
     Wanderer wanderer(world, model, opt.speed);
     world.setListener(&wanderer);
     for (int id : world.robotIds()) world.setCommand(id, mbot_sim::Twist2D{opt.speed, 0.0, 0.0});
@@ -234,9 +254,11 @@ int main(int argc, char** argv)
     std::printf(
         "{\"robots\": %d, \"sim_seconds\": %.3f, \"wall_seconds\": %.3f, \"rtf\": %.3f, \"rays_per_second\": %.0f, "
         "\"peak_rss_mb\": %.1f, \"cpu_seconds\": %.3f, \"rtf_cpu\": %.3f, \"load_seconds\": %.3f, "
-        "\"rtf_with_loading\": %.3f, \"map\": \"%s\", \"wall_boxes\": %zu}\n",
+        "\"rtf_with_loading\": %.3f, \"map\": \"%s\", \"wall_boxes\": %zu, \"lidar_robots\": %d, "
+        "\"lidar_rays_per_second\": %.0f, \"lidar_rays_per_cpu_second\": %.0f, \"lidar_points\": %llu}\n",
         opt.robots, sim, wall, sim / wall, world.raysCast() / wall, peakRssMb(), cpu, sim / cpu, load,
-        sim / (load + wall), opt.map.c_str(), world.wallBoxCount());
+        sim / (load + wall), opt.map.c_str(), world.wallBoxCount(), opt.lidar, world.lidarRaysCast() / wall,
+        world.lidarRaysCast() / cpu, wanderer.points);
   }
   catch (const std::exception& e)
   {
