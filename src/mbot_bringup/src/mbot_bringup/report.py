@@ -25,7 +25,7 @@ import sys
 
 from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_data import METRIC_BY_KEY, METRICS, STATES, LabCriteria, ReportError, arrival_time, \
-    assignments, compare_rows, evaluate, format_value, parse_criteria, run_numbers, sorted_events, \
+    assignments, compare_rows, evaluate, format_value, parse_criteria, pause_spans, run_numbers, sorted_events, \
     switch_settling, target_time
 from mbot_follower.metrics.settle import SWITCH_HOLD, SWITCH_TOLERANCE, switch_done_times
 from mbot_bringup.report_scans import read_scans
@@ -125,7 +125,7 @@ class RunInputs(object):
 STYLE_CSS = """body{font-family:sans-serif;max-width:72em;margin:1.5em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #bbb;padding:0.2em 0.6em;text-align:right}
 th{background:#f0f0f0}td.l,th.l{text-align:left}img{max-width:100%}.pass{background:#d9f2d9}
-.fail{background:#f7c6c6}.verdict{font-size:1.3em;padding:0.4em 0.8em;display:inline-block}
+.fail{background:#f7c6c6}.pause{background:#ffe3c7}.verdict{font-size:1.3em;padding:0.4em 0.8em;display:inline-block}
 figure{display:inline-block;margin:0.5em;vertical-align:top}figcaption{text-align:center;font-size:0.9em}
 .chip{display:inline-block;width:0.9em;height:0.9em;border-radius:50%;vertical-align:middle;margin-right:0.2em}
 .side{display:flex;gap:1em}.side>div{flex:1}pre{background:#f6f6f6;padding:0.5em;overflow:auto}"""
@@ -194,19 +194,28 @@ def _fact(value):
 
 def timeline_table(inputs):
     """What happened, from the target on: state changes with their reason, switches, losses,
-    rejoins, contacts."""
+    rejoins, contacts, leader pauses (start with the reason, end with the length)."""
     t0 = target_time(inputs.run)
+    run = inputs.run
+    pauses = pause_spans(run, run.samples[-1].t if run.samples else t0)
     rows = []
-    for e in sorted_events(inputs.run):
+    for e in sorted_events(run):
         if e.kind == "assignment":
             continue
         what = {"state": "state %s" % e.name, "switch": "switch %s &rarr; %s" % (esc(e.detail), esc(e.name)),
                 "loss": "lost %s" % e.name, "rejoin": "%s rejoined" % e.name,
-                "contact": "contact %s &harr; %s at (%.2f, %.2f) m" % (esc(e.name), esc(e.detail), e.x, e.y)}
+                "contact": "contact %s &harr; %s at (%.2f, %.2f) m" % (esc(e.name), esc(e.detail), e.x, e.y),
+                "pause": "leader paused" if e.name == "start" else "pause ends"}
         text = what.get(e.kind, "%s %s" % (e.kind, e.name))
         detail = esc(e.detail) if e.kind == "state" else ""
+        if e.kind == "pause":
+            if e.name == "start":
+                detail = esc(next((p.reason for p in pauses if abs(p.start - e.t) < 1e-9), e.detail))
+            else:
+                length = [e.t - p.start for p in pauses if abs(p.end - e.t) < 1e-9]
+                detail = esc("; ".join(d for d in ["after %.2f s" % length[0] if length else "", e.detail] if d))
         css = "fail" if e.kind in ("loss", "contact") or (e.kind == "state" and e.name in ("DEGRADED", "ABORTED")) \
-            else ""
+            else "pause" if e.kind == "pause" else ""
         rows.append(([text if e.kind in ("switch", "contact") else esc(text), detail, "%.2f" % (e.t - t0)], css))
     return table(["what", "why (the coordinator's reason)", "time from target [s]"], rows, left=2)
 

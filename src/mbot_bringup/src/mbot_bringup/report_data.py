@@ -211,10 +211,37 @@ def state_spans(run, end):
 #: any other event kind the collector adds), label, the event's name (the robot of a loss).
 Mark = namedtuple("Mark", "t kind label name")
 
+#: A leader pause: from start to end [s sim] (end: the run's end if it never ended), and the
+#: coordinator's reason without its "paused: " head.
+Pause = namedtuple("Pause", "start end reason")
+
+
+def _pause_reason(detail):
+    return detail[len("paused:"):].strip() if detail.startswith("paused:") else detail.strip()
+
+
+def pause_spans(run, end):
+    """[Pause] from the collector's pause events (start / end, with the reason at the start); a
+    pause still on at `end` [s sim] lasts until then. The coordinator's state stays NAVIGATING
+    during a pause: these events are all that records it."""
+    spans, start = [], None
+    for e in sorted_events(run):
+        if e.kind != "pause":
+            continue
+        if e.name == "start" and start is None:
+            start = e
+        elif e.name == "end" and start is not None:
+            spans.append(Pause(start.t, e.t, _pause_reason(start.detail)))
+            start = None
+    if start is not None:
+        spans.append(Pause(start.t, max(end, start.t), _pause_reason(start.detail)))
+    return spans
+
 
 def event_marks(run):
-    """[Mark] of what happened: switches, losses, rejoins, contacts, pauses (the coordinator's
-    reason starts with "paused"), and any event kind other than states and assignments."""
+    """[Mark] of what happened: switches, losses, rejoins, contacts, the start of each pause
+    (labelled with its reason; pause_spans gives its length), and any event kind other than
+    states and assignments."""
     marks = []
     for e in sorted_events(run):
         if e.kind == "switch":
@@ -225,10 +252,10 @@ def event_marks(run):
             marks.append(Mark(e.t, "rejoin", e.name + " back", e.name))
         elif e.kind == "contact":
             marks.append(Mark(e.t, "contact", "contact %s-%s" % (e.name, e.detail), e.name))
-        elif e.kind == "state":
-            if e.detail.startswith("paused"):
-                marks.append(Mark(e.t, "pause", "pause", e.name))
-        elif e.kind != "assignment":
+        elif e.kind == "pause":
+            if e.name == "start":   # the end closes the shaded span; no line of its own
+                marks.append(Mark(e.t, "pause", "pause: " + _pause_reason(e.detail), e.name))
+        elif e.kind not in ("state", "assignment"):
             marks.append(Mark(e.t, e.kind, ("%s %s" % (e.kind, e.name)).strip(), e.name))
     return marks
 

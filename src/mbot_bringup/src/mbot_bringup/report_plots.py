@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from mbot_bringup.report_data import Series, arrival_time, assignment_at, assignments, event_marks, \
+from mbot_bringup.report_data import Series, arrival_time, assignment_at, assignments, event_marks, pause_spans, \
     fleet_path_length, leader_trail, slot_positions, speeds, state_spans
 
 
@@ -248,9 +248,12 @@ def shade_states(ax, run, series, label=True):
 
 
 def mark_events(ax, run, t0, label=True):
-    """A vertical line per event (switch, loss, rejoin, pause, contact ...), labelled."""
+    """A vertical line per event (switch, loss, rejoin, pause, contact ...), labelled; each leader
+    pause shaded from its start to its end."""
     import matplotlib.transforms as mtransforms
     trans = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+    for p in pause_spans(run, run.samples[-1].t if run.samples else t0):
+        ax.axvspan(p.start - t0, p.end - t0, color=STYLE.mark_colors["pause"], alpha=0.25, lw=0, zorder=1)
     shown = []
     for m in event_marks(run):
         t = m.t - t0

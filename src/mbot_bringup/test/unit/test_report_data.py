@@ -1,14 +1,16 @@
 """The report's numbers (report_data) and plot helpers (report_plots) on plain data: criteria,
 slots of an assignment, speeds, what is better in a comparison, robot colours."""
+import importlib.util
 import math
 import os
 
 import numpy as np
 import pytest
+from matplotlib.colors import to_rgb
 
 from mbot_bringup.report_data import Criterion, LabCriteria, ReportError, Series, arrival_time, assignment_at, \
-    assignments, compare_rows, evaluate, event_marks, format_value, parse_criteria, run_numbers, slot_positions, \
-    speeds, switch_settling
+    assignments, compare_rows, evaluate, event_marks, format_value, parse_criteria, pause_spans, run_numbers, \
+    slot_positions, speeds, switch_settling
 from mbot_bringup.colors import robot_colors
 from mbot_bringup.report_plots import error_limit, snapshot_indices, snapshot_labels
 from mbot_follower.metrics import Event, Run, RobotSample, Sample, load_run, summarize
@@ -180,17 +182,77 @@ def test_snapshots_at_one_place_share_one_time_label():
 
 
 def test_events_to_mark_on_the_time_axes():
+    # the events as the collector writes them (mbot_follower.metrics.records.Event); a pause is
+    # its own start / end events, the state stays NAVIGATING
     run = Run()
     run.events = [Event(5.0, "contact", "follower_1", "map", 1.0, 2.0),
                   Event(1.0, "state", "NAVIGATING", "formation reached", NAN, NAN),
-                  Event(2.0, "state", "FORMING", "paused: obstacle in front of the leader leader", NAN, NAN),
+                  Event(2.0, "pause", "start", "paused: obstacle in front of the leader leader", NAN, NAN),
+                  Event(2.8, "pause", "end", "resuming: the way is free", NAN, NAN),
                   Event(3.0, "loss", "follower_2", "", NAN, NAN),
                   Event(4.0, "rejoin", "follower_2", "", NAN, NAN),
                   Event(4.5, "assignment", "line", "leader L spacing 1 m slots L(0,0)", NAN, NAN),
-                  Event(6.0, "fault", "follower_1", "drive_frozen", NAN, NAN)]
+                  Event(6.0, "fault", "follower_1", "drive_frozen", NAN, NAN),
+                  Event(7.0, "pause", "start", "paused: scan of leader is 0.5 s old", NAN, NAN)]
     assert [(m.t, m.kind, m.label) for m in event_marks(run)] == [
-        (2.0, "pause", "pause"), (3.0, "loss", "lost follower_2"), (4.0, "rejoin", "follower_2 back"),
-        (5.0, "contact", "contact follower_1-map"), (6.0, "fault", "fault follower_1")]
+        (2.0, "pause", "pause: obstacle in front of the leader leader"), (3.0, "loss", "lost follower_2"),
+        (4.0, "rejoin", "follower_2 back"), (5.0, "contact", "contact follower_1-map"),
+        (6.0, "fault", "fault follower_1"), (7.0, "pause", "pause: scan of leader is 0.5 s old")]
+    # the second pause is still on when the run ends at 9 s
+    assert pause_spans(run, 9.0) == [(2.0, 2.8, "obstacle in front of the leader leader"),
+                                     (7.0, 9.0, "scan of leader is 0.5 s old")]
+
+
+def _coordinator_fleet_module():
+    """mbot_follower's test_coordinator_events (the coordinator node wired to the metrics
+    collector node, no master), loaded by its path: the record below is what it writes."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "mbot_follower", "test",
+                        "unit", "test_coordinator_events.py")
+    spec = importlib.util.spec_from_file_location("coordinator_events_for_the_report", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_leader_pause_from_the_coordinators_record_is_a_shaded_span_and_a_row_with_its_reason(monkeypatch,
+                                                                                                tmp_path):
+    from mbot_common.geometry import Pose2D
+    from mbot_follower.metrics import RunWriter
+    from mbot_bringup.report import timeline_table
+    from mbot_bringup.report_plots import STYLE, mark_events, pyplot
+    fleet = _coordinator_fleet_module().Fleet(monkeypatch)
+    assert fleet.node._set_goal(Pose2D(20.0, 0.0, 0.0))[0]
+    fleet.run(2.0)
+    fleet.obstacle = True                    # close in front of the leader: the coordinator pauses
+    fleet.run(0.3)
+    fleet.obstacle = False
+    fleet.run(1.5)                           # the pause ends after pause_time
+    RunWriter(str(tmp_path)).write(fleet.metrics.collector.run, {})
+    run = load_run(str(tmp_path))            # events.csv read back, as the report reads it
+    end = max(e.t for e in run.events)
+    spans = pause_spans(run, end)
+    assert len(spans) == 1
+    start, stop, reason = spans[0]
+    assert reason == "obstacle in front of the leader robot_0"
+    assert stop - start == pytest.approx(fleet.node.core.config.pause_time, abs=0.1 + 1e-6)
+    assert [(m.t, m.label) for m in event_marks(run) if m.kind == "pause"] == [
+        (start, "pause: obstacle in front of the leader robot_0")]
+    # the "What happened" table: the start with its reason, the end with the length
+    page = timeline_table(type("Inputs", (), {"run": run})())
+    t0 = next(e.t for e in run.events if e.kind == "state" and e.name == "FORMING")
+    assert ('<tr class="pause"><td class="l">leader paused</td><td class="l">obstacle in front of the leader '
+            'robot_0</td><td>%.2f</td></tr>' % (start - t0)) in page
+    assert ('<td class="l">pause ends</td><td class="l">after %.2f s; resuming: ' % (stop - start)) in page
+    # the plots: one span from start to end in the pause colour
+    plt = pyplot()
+    fig, ax = plt.subplots()
+    ax.set_xlim(0.0, end - t0)
+    mark_events(ax, run, t0)
+    shaded = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx(to_rgb(STYLE.mark_colors["pause"]))]
+    assert len(shaded) == 1
+    xs = shaded[0].get_patch_transform().transform(shaded[0].get_path().vertices)[:, 0]   # data x
+    assert min(xs) == pytest.approx(start - t0) and max(xs) == pytest.approx(stop - t0)
+    plt.close(fig)
 
 
 def test_a_column_along_the_path_has_its_slots_on_the_leaders_path():
