@@ -14,12 +14,14 @@
                                       and the fleet trial: 3 robots at once in `office` with its
                                       walking person, particle filter, goals split among them
         --fleet-runs N (default 100 in all; 0 skips it)
-    scripts/bench formation [--json FILE] [--seeds N] [--sizes 3,5,10]
+    scripts/bench formation [--json FILE] [--seeds N] [--sizes 3,5,10] [--laws slot_tracking,mpc]
                                       the formation fleet at real_time_factor 0 with lockstep:
                                       convergence, straight and route slot error, switch time,
                                       recovery after a loss, contacts, controller cycle time;
                                       for 3 robots also the office route (doors, corridor) as
-                                      the row "3 office" (mbot_follower/formation_bench.py)
+                                      the row "3 office" (mbot_follower/formation_bench.py);
+                                      --laws: a row per control law ("3 mpc"), with the slot
+                                      error p95, the least clearance and the mpc solve time
     scripts/bench fleet [--json FILE] [--sizes 3,10,20,40] [--modes formation,navigation]
                                       what the fleet around the simulator costs: real-time
                                       factor, CPU s per robot per sim s and each process kind's
@@ -204,11 +206,12 @@ def bench_nav(trial_runs=100, trial_rtf=0.0, fleet_runs=100):
     return result
 
 
-def bench_formation(seeds, sizes):
-    """The whole formation stack (many processes, so not pinned to one core); worst of the seeds."""
-    print("$ formation_bench --seeds %d --sizes %s --json" % (seeds, sizes), file=sys.stderr)
+def bench_formation(seeds, sizes, laws="slot_tracking"):
+    """The whole formation stack (many processes, so not pinned to one core); worst of the seeds.
+    laws: the followers' control laws, each its own rows."""
+    print("$ formation_bench --seeds %d --sizes %s --laws %s --json" % (seeds, sizes, laws), file=sys.stderr)
     out = subprocess.run(["/usr/bin/python3", "-m", "mbot_follower.formation_bench", "--seeds", str(seeds),
-                          "--sizes", sizes, "--json"], check=True, stdout=subprocess.PIPE,
+                          "--sizes", sizes, "--laws", laws, "--json"], check=True, stdout=subprocess.PIPE,
                          universal_newlines=True).stdout
     return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
 
@@ -327,6 +330,17 @@ def print_table(result):
                 n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
                 f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
                 f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
+        # the law comparison (issue 26): p95 slot error of the switch (office: of the route), the
+        # closest two robots (centres - 2 radii; target >= 0.05 m), the mpc solve time
+        print("\n  %-12s %16s %14s %15s %15s %16s" % ("robots", "slot p95 m", "clearance m", "mpc solve p50",
+                                                      "mpc solve p99", "mpc fallbacks"))
+        for n, r in rows:
+            def g(key, fmt):
+                return fmt % r[key] if r.get(key) is not None else "-"
+            fallbacks = "%d/%d" % (r["mpc_fallbacks"], r["mpc_solves"]) if "mpc_solves" in r else "-"
+            print("  %-12s %16s %14s %15s %15s %16s" % (
+                n, g("slot_p95_switch_m", "%.3f"), g("min_clearance_m", "%.3f"), g("mpc_solve_p50_ms", "%.1f ms"),
+                g("mpc_solve_p99_ms", "%.1f ms"), fallbacks))
     if "mapf" in result:
         st = result["mapf_settings"]
         name = st["algorithm"] + (" w=%g" % st["w"] if st["algorithm"] in ("ecbs", "eecbs") else "")
@@ -370,6 +384,8 @@ def main(argv=None):
     parser.add_argument("--sim-runs", type=int, default=3, help="sim: runs per fleet size (median and range)")
     parser.add_argument("--seeds", type=int, default=10, help="formation: seeds per fleet size")
     parser.add_argument("--sizes", help="formation: fleet sizes (default 3,5,10); fleet: (default 3,10,20,40)")
+    parser.add_argument("--laws", default="slot_tracking",
+                        help="formation: the followers' control laws, e.g. slot_tracking,mpc (default slot_tracking)")
     parser.add_argument("--modes", default="formation,navigation", help="fleet: formation, navigation or both")
     parser.add_argument("--maps", default=",".join(MAPF_MAPS), help="mapf: map names (default: all five)")
     parser.add_argument("--time-limit", type=float, default=60.0, help="mapf: seconds per instance (default 60)")
@@ -388,7 +404,7 @@ def main(argv=None):
     if args.what in ("nav", "all"):
         result.update(bench_nav(args.trial_runs, args.trial_rtf, args.fleet_runs))
     if args.what == "formation":
-        result.update(bench_formation(args.seeds, args.sizes or "3,5,10"))
+        result.update(bench_formation(args.seeds, args.sizes or "3,5,10", args.laws))
     if args.what == "fleet":
         if not set(args.modes.split(",")) <= {"formation", "navigation"}:
             parser.error("--modes: formation, navigation or both (comma-separated)")

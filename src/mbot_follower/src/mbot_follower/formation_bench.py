@@ -41,6 +41,14 @@ to the last arrival (doors, corridor and both turns), **converge_s** as in 1, **
 3 (triangle -> column, standing at the door), **route_s** is the sim time from the first target
 to the last arrival; the world's seed is the run's seed.
 
+The **law** is a dimension (``--laws slot_tracking,mpc``: the followers' ``controller``): the rows
+of slot_tracking keep their keys ("3", "3" office), another law's rows are "3 mpc". Every row
+also has **slot_p95_switch_m** (the followers' slot errors from the diamond -> column switch
+until it is done, 95th percentile; the office row: over the route, as rms_route_m),
+**min_clearance_m** (the metrics' closest two robots: centre distance - 2 radii, lowest over
+the run) and, for mpc, **mpc_solve_p50_ms** / **mpc_solve_p99_ms** (the worst robot's, from
+each controller's ``~mpc_stats``) and **mpc_fallbacks** of **mpc_solves**.
+
 The parent process runs one child process per run (rospy allows one node per process).
 """
 import argparse
@@ -66,6 +74,7 @@ MIN_GAP = 0.6                  # [m] centre distance between any two starting ro
 ROOM = 19.0                    # [m] starting places stay within +-ROOM
 OFFICE_SIZES = (3,)            # the office route: the office world's three robots
 OFFICE_SPACING = 1.0           # [m] a triangle of 1 m fits the office's rooms (as office_route)
+LAWS = ("slot_tracking",)      # the followers' control law (the controller parameter)
 
 
 def formation_for(n):
@@ -125,7 +134,8 @@ def office_timings(run, route):
     from mbot_follower.metrics import switch_done_times
 
     events = sorted(run.events, key=lambda e: e.t)
-    out = {"converge_s": None, "switch_s": None, "rms_route_m": moving_rms(run, route[0], route[1])}
+    out = {"converge_s": None, "switch_s": None, "rms_route_m": moving_rms(run, route[0], route[1]),
+           "slot_p95_switch_m": moving_p95(run, route[0], route[1])}
     done = next((d["switch_time_s"] for d in switch_done_times(run) if d["formation"] == "column"), None)
     if done is not None:
         out["switch_s"] = round(done, 2)
@@ -144,10 +154,29 @@ def worst(runs):
            "overruns": sum(r.get("overruns") or 0 for r in runs),
            "late_starts": sum(r.get("late_starts") or 0 for r in runs)}
     for key in ("rms_straight_m", "rms_route_m", "converge_s", "switch_s", "degraded_s", "recover_s",
-                "cycle_p99_ms", "route_s"):
+                "cycle_p99_ms", "route_s", "slot_p95_switch_m", "mpc_solve_p50_ms", "mpc_solve_p99_ms"):
         values = [r[key] for r in runs if r.get(key) is not None]
         row[key] = round(max(values), 4) if values else None
+    clearances = [r["min_clearance_m"] for r in runs if r.get("min_clearance_m") is not None]
+    row["min_clearance_m"] = round(min(clearances), 4) if clearances else None
+    if any("mpc_solves" in r for r in runs):
+        row["mpc_solves"] = sum(r.get("mpc_solves", 0) for r in runs)
+        row["mpc_fallbacks"] = sum(r.get("mpc_fallbacks", 0) for r in runs)
     return row
+
+
+def mpc_figures(stats):
+    """The row's mpc figures from each controller's last ~mpc_stats {robot: stats}: the worst
+    robot's solve time p50 and p99 [ms], solves and fallbacks summed."""
+    if not stats:
+        return {}
+    out = {"mpc_solves": sum(s.get("solves", 0) for s in stats.values()),
+           "mpc_fallbacks": sum(s.get("fallbacks", 0) for s in stats.values())}
+    for key in ("solve_ms_p50", "solve_ms_p99"):
+        values = [s[key] for s in stats.values() if key in s]
+        if values:
+            out["mpc_" + key.replace("solve_ms_", "solve_") + "_ms"] = max(values)
+    return out
 
 
 MOVING = 0.1                    # [m/s] the leader at least this fast: its followers' errors count
@@ -167,6 +196,24 @@ def moving_rms(run, since, until):
     return None if rms is None else round(rms, 4)
 
 
+def moving_p95(run, since, until):
+    """The 95th percentile [m] of the followers' slot errors in the samples moving_rms takes."""
+    from mbot_follower.metrics import PLAN_STATES, leader_speed
+
+    errors = []
+    for before, s in zip(run.samples, run.samples[1:]):
+        if since <= s.t < until and s.state in PLAN_STATES and leader_speed(before, s) >= MOVING:
+            errors += [rs.slot_error for rs in s.robots.values() if math.isfinite(rs.slot_error)]
+    return round(float(np.percentile(errors, 95)), 4) if errors else None
+
+
+def window_p95(run, since, until):
+    """The 95th percentile [m] of the followers' slot errors in every sample since <= t <= until."""
+    errors = [rs.slot_error for s in run.samples if since <= s.t <= until
+              for rs in s.robots.values() if math.isfinite(rs.slot_error)]
+    return round(float(np.percentile(errors, 95)), 4) if errors else None
+
+
 def timings(run, route=None):
     """converge_s, switch_s, degraded_s, recover_s [s], rms_straight_m and rms_route_m [m] from a
     metrics collector's Run (its events, samples and controller cycles carry the data's sim
@@ -176,7 +223,7 @@ def timings(run, route=None):
 
     events = sorted(run.events, key=lambda e: e.t)
     out = {"converge_s": None, "switch_s": None, "degraded_s": None, "recover_s": None,
-           "rms_straight_m": None, "rms_route_m": None}
+           "rms_straight_m": None, "rms_route_m": None, "slot_p95_switch_m": None}
     if route is not None:
         out["rms_route_m"] = moving_rms(run, route[0], route[1])
     forming = next((e.t for e in events if e.kind == "state" and e.name == "FORMING"), None)
@@ -191,6 +238,7 @@ def timings(run, route=None):
         done = next((d["switch_time_s"] for d in switch_done_times(run) if d["t_s"] == switch), None)
         if done is not None:
             out["switch_s"] = round(done, 2)
+            out["slot_p95_switch_m"] = window_p95(run, switch, switch + done)
     # the kill: a loss for good. A robot lost for a moment (its controller starved on a busy
     # machine, as the fleet starts) rejoins, and that loss is not the one measured.
     loss = next((e for e in events if e.kind == "loss" and not any(
@@ -215,6 +263,21 @@ def timings(run, route=None):
 
 # --- one run (child process) -----------------------------------------------------------------
 
+def listen_mpc_stats(robots):
+    """{robot: its controller's last ~mpc_stats} (filled while the run goes on; empty without mpc)."""
+    import rospy
+    from std_msgs.msg import String
+
+    stats = {}
+
+    def on_stats(msg, robot):
+        stats[robot] = json.loads(msg.data)
+
+    for robot in robots:
+        rospy.Subscriber("/%s/follower_controller/mpc_stats" % robot, String, on_stats, robot, queue_size=1)
+    return stats
+
+
 def drive(n, seed, log):
     """Play the steps of one run against the fleet already launched; returns what the probe
     saw (contacts, the route's window); the measures come from the record afterwards (`timings`)."""
@@ -225,6 +288,7 @@ def drive(n, seed, log):
     from mbot_follower.fleet_probe import FleetProbe
 
     robots = ["robot_%d" % i for i in range(n)]
+    mpc_stats = listen_mpc_stats(robots)
     probe = FleetProbe(robots, pace=True)
     probe.wait_for_fleet(wall_timeout=300.0)
     result = {"n": n, "seed": seed, "succeeded": False}
@@ -293,6 +357,7 @@ def drive(n, seed, log):
     result["contacts"] = len(probe.contacts)
     result["succeeded"] = probe.state() == "ARRIVED"
     wait_for_record(rospy.get_time(), 120.0, log)
+    result.update(mpc_figures(dict(mpc_stats)))
     return result
 
 
@@ -304,6 +369,7 @@ def drive_office(n, seed, log):
 
     from mbot_follower.fleet_probe import FleetProbe
 
+    mpc_stats = listen_mpc_stats(["robot_%d" % i for i in range(n)])
     probe = FleetProbe(["robot_%d" % i for i in range(n)], pace=True)
     probe.wait_for_fleet(wall_timeout=300.0)
     result = {"n": n, "seed": seed, "succeeded": False}
@@ -332,6 +398,7 @@ def drive_office(n, seed, log):
     result["contacts"] = len(probe.contacts)
     result["succeeded"] = probe.state() == "ARRIVED"
     wait_for_record(rospy.get_time(), 120.0, log)
+    result.update(mpc_figures(dict(mpc_stats)))
     return result
 
 
@@ -362,13 +429,14 @@ def wait_for_record(until, wall_timeout, log):
     return False
 
 
-def run_one(n, seed, out_dir, log, office=False):
-    """Launch the fleet for (n, seed) on a private master, drive it (office: the office route),
-    stop it. Returns measures."""
+def run_one(n, seed, out_dir, log, office=False, law=LAWS[0]):
+    """Launch the fleet for (n, seed) with the followers' control law `law` on a private master,
+    drive it (office: the office route), stop it. Returns measures."""
     from mbot_common.paths import find_maps_directory
     from mbot_navigation.nav_trial import free_port, stop, wait_for_sim_time
 
-    run_dir = os.path.join(out_dir, "%sn%d_seed%d" % ("office_" if office else "", n, seed))
+    suffix = "" if law == LAWS[0] else "_" + law
+    run_dir = os.path.join(out_dir, "%sn%d_seed%d%s" % ("office_" if office else "", n, seed, suffix))
     shutil.rmtree(run_dir, ignore_errors=True)
     os.makedirs(run_dir)
     world = os.path.join(run_dir, "world.yaml")
@@ -383,18 +451,18 @@ def run_one(n, seed, out_dir, log, office=False):
     launch_log = os.path.join(run_dir, "roslaunch.log")
     cmd = ["roslaunch", "-p", str(port), "mbot_follower", "formation.launch", "world:=" + world,
            "formation:=" + formation_for(n), "spacing:=%g" % (OFFICE_SPACING if office else SPACING),
-           "real_time_factor:=0", "lockstep:=true",
+           "real_time_factor:=0", "lockstep:=true", "controller:=" + law,
            "metrics_dir:=" + os.path.join(run_dir, "metrics")]
     with open(launch_log, "w") as f:
         process = subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
-    result = {"n": n, "seed": seed, "succeeded": False}
+    result = {"n": n, "seed": seed, "succeeded": False, "law": law}
     try:
         import rospy
 
         wait_for_sim_time("formation_bench", launch_log, wall_timeout=120.0)
         rospy.init_node("formation_bench", disable_signals=True)
         started = time.time()
-        result = (drive_office if office else drive)(n, seed, log)
+        result = dict((drive_office if office else drive)(n, seed, log), law=law)
         result["wall_s"] = round(time.time() - started, 1)
     except Exception as error:  # a failed run is a row of the table, not a crash of the benchmark
         result["error"] = str(error).splitlines()[0]
@@ -411,6 +479,7 @@ def run_one(n, seed, out_dir, log, office=False):
         result["overruns"] = fleet.get("cycle_overruns")
         result["late_starts"] = fleet.get("cycle_late_starts")
         result["contacts"] = max(result.get("contacts", 0), fleet.get("contacts") or 0)
+        result["min_clearance_m"] = fleet.get("min_clearance_m")
         try:
             if office:
                 record = load_run(os.path.dirname(metrics))
@@ -439,6 +508,8 @@ def parse_args(argv):
     parser.add_argument("--first-seed", type=int, default=1)
     parser.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "formation_bench"),
                         help="run folders (world, launch log, metrics)")
+    parser.add_argument("--laws", default=",".join(LAWS),
+                        help="the followers' control laws, each a row (default %(default)s; e.g. slot_tracking,mpc)")
     parser.add_argument("--json", action="store_true", help="print the table as one JSON line")
     parser.add_argument("--one", nargs=2, type=int, metavar=("N", "SEED"), help=argparse.SUPPRESS)
     parser.add_argument("--office", action="store_true", help=argparse.SUPPRESS)   # --one: the office route
@@ -452,29 +523,39 @@ def main(argv=None):
         print("formation_bench: " + message, file=sys.stderr)
         sys.stderr.flush()
 
+    from mbot_follower.control_laws import CONTROL_LAWS
+
+    laws = [law for law in args.laws.split(",") if law]
+    unknown = [law for law in laws if law not in CONTROL_LAWS]
+    if unknown or not laws:
+        sys.exit("formation_bench: --laws: %s: expected control laws of %s" % (
+            ", ".join(unknown) or "none given", ", ".join(sorted(CONTROL_LAWS))))
     if args.one:  # child: one run, its measures as the last line of stdout
-        print(json.dumps(run_one(args.one[0], args.one[1], args.out, log, office=args.office)))
+        print(json.dumps(run_one(args.one[0], args.one[1], args.out, log, office=args.office, law=laws[0])))
         return 0
 
-    def row(n, office):
+    def row(n, office, law):
         runs = []
         for seed in range(args.first_seed, args.first_seed + args.seeds):
             out = subprocess.run([sys.executable, "-m", "mbot_follower.formation_bench", "--one", str(n), str(seed),
-                                  "--out", args.out] + (["--office"] if office else []),
+                                  "--out", args.out, "--laws", law] + (["--office"] if office else []),
                                  stdout=subprocess.PIPE, universal_newlines=True)
             lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
             run = json.loads(lines[-1]) if lines else {
                 "n": n, "seed": seed, "succeeded": False, "error": "the run printed nothing (exit %d)" % out.returncode}
-            log("%sn=%d seed=%d: %s" % ("office " if office else "", n, seed, json.dumps(run)))
+            log("%sn=%d seed=%d %s: %s" % ("office " if office else "", n, seed, law, json.dumps(run)))
             runs.append(run)
         out = worst(runs)
         out["details"] = runs
         return out
 
     sizes = [int(s) for s in args.sizes.split(",")]
-    table = {str(n): row(n, False) for n in sizes}
-    # the office route: its own row, for the sizes the office world holds
-    office = {str(n): row(n, True) for n in sizes if n in OFFICE_SIZES}
+    table, office = {}, {}
+    for law in laws:   # slot tracking's rows keep their keys ("3"); another law's: "3 mpc"
+        name = "" if law == LAWS[0] else " " + law
+        table.update({str(n) + name: row(n, False, law) for n in sizes})
+        # the office route: its own row, for the sizes the office world holds
+        office.update({str(n) + name: row(n, True, law) for n in sizes if n in OFFICE_SIZES})
     result = {"formation": table, "formation_office": office}
     if args.json:
         print(json.dumps(result))

@@ -2,6 +2,8 @@
 data's sim time), not from when its probe noticed a condition."""
 import math
 
+import pytest
+
 from mbot_follower.formation_bench import moving_rms, start_poses, timings, worst
 from mbot_follower.metrics import ControllerSample, Event, RobotSample, Run, Sample
 
@@ -49,7 +51,8 @@ def recorded_run():
 def test_the_times_come_from_the_stamps_of_the_record():
     got = timings(recorded_run())
     assert got == {"converge_s": 4.5, "switch_s": 4.3, "degraded_s": 1.1, "recover_s": 4.0,
-                   "rms_straight_m": None, "rms_route_m": None}   # no robot in these samples
+                   "rms_straight_m": None, "rms_route_m": None,   # no robot in these samples
+                   "slot_p95_switch_m": 1.665}   # the samples 50.0-54.3 s: 1.8, 0.9, 0.31, 0.29 m
 
 
 def test_the_switch_ends_only_in_the_new_formation_and_under_the_tolerance():
@@ -175,5 +178,27 @@ def test_the_office_row_is_timed_from_the_record():
     got = office_timings(run, (20.0, 40.0))
     assert got["converge_s"] == 4.5
     assert math.isclose(got["rms_route_m"], 0.1)
+    assert math.isclose(got["slot_p95_switch_m"], 0.1)   # the office row's p95: over the route
     assert got["switch_s"] is None   # no switch in this record
-    assert office_timings(Run(), (20.0, 40.0)) == {"converge_s": None, "switch_s": None, "rms_route_m": None}
+    assert office_timings(Run(), (20.0, 40.0)) == {"converge_s": None, "switch_s": None, "rms_route_m": None,
+                                                   "slot_p95_switch_m": None}
+
+
+def test_the_law_rows_mpc_figures_and_clearance():
+    """The worst robot's solve times, solves and fallbacks summed; the row's clearance is the
+    lowest of its runs, its slot p95 the highest; an unknown law is refused by name."""
+    from mbot_follower.formation_bench import main, mpc_figures, worst
+
+    stats = {"robot_1": {"solves": 100, "fallbacks": 2, "solve_ms_p50": 3.0, "solve_ms_p99": 12.0},
+             "robot_2": {"solves": 90, "fallbacks": 0, "solve_ms_p50": 4.0, "solve_ms_p99": 9.0}}
+    got = mpc_figures(stats)
+    assert got == {"mpc_solves": 190, "mpc_fallbacks": 2, "mpc_solve_p50_ms": 4.0, "mpc_solve_p99_ms": 12.0}
+    assert mpc_figures({}) == {}
+    runs = [dict(got, succeeded=True, contacts=0, min_clearance_m=0.4, slot_p95_switch_m=0.2),
+            dict(got, succeeded=True, contacts=0, min_clearance_m=0.2, slot_p95_switch_m=0.1)]
+    row = worst(runs)
+    assert row["min_clearance_m"] == 0.2 and row["slot_p95_switch_m"] == 0.2
+    assert row["mpc_solves"] == 380 and row["mpc_fallbacks"] == 4 and row["mpc_solve_p99_ms"] == 12.0
+    assert "mpc_solves" not in worst([{"succeeded": True, "contacts": 0}])
+    with pytest.raises(SystemExit, match=r"--laws: pid: expected control laws of consensus, mpc, slot_tracking"):
+        main(["--laws", "slot_tracking,pid"])
