@@ -282,6 +282,30 @@ def bench_mapf(maps, time_limit, max_agents, algorithm, w=1.05, agents=None):
                                              "agents": agents, "max_agents": max_agents}, "mapf_runs": runs}
 
 
+def formation_table(result):
+    """The formation benchmark's main table (text): a row per fleet size (and "3 office"), the
+    worst over the seeds; beside the cycle time p99 the cycles over the 50 ms period (overruns)
+    and those started a period or more late, summed over the seeds ("-": not in the result)."""
+    lines = ["\nFormation (worst over seeds; targets: straight <= 0.05 m, route <= 0.15 m, converge <= 10 s,"
+             " switch <= 6 s, DEGRADED <= 2 s, re-converged <= 10 s, 0 contacts)",
+             "  %-8s %9s %9s %11s %10s %11s %8s %10s %10s %9s %9s %11s %10s" % (
+                 "robots", "succeeded", "contacts", "straight m", "route m", "converge s", "switch s",
+                 "degraded s", "recover s", "cycle p99", "overruns", "late starts", "wall s")]
+    rows = [(n, r) for n, r in result["formation"].items()]
+    rows += [("%s office" % n, r) for n, r in result.get("formation_office", {}).items()]   # the office route
+    for n, r in rows:
+        wall = max((d.get("wall_s") or 0) for d in r.get("details", [{}]))
+
+        def f(key, fmt):
+            return fmt % r[key] if r.get(key) is not None else "-"
+        lines.append("  %-8s %9s %9d %11s %10s %11s %8s %10s %10s %9s %9s %11s %10.0f" % (
+            n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
+            f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
+            f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), f("overruns", "%d"), f("late_starts", "%d"),
+            wall))
+    return "\n".join(lines)
+
+
 def print_table(result):
     if "rtf" in result:
         print("\nSimulator (one core, as fast as possible, 360-beam 10 Hz lasers, 100 Hz physics)")
@@ -314,22 +338,9 @@ def print_table(result):
 
         print(fleet_bench.table(result))
     if "formation" in result:
-        print("\nFormation (worst over seeds; targets: straight <= 0.05 m, route <= 0.15 m, converge <= 10 s,"
-              " switch <= 6 s, DEGRADED <= 2 s, re-converged <= 10 s, 0 contacts)")
-        print("  %-8s %9s %9s %11s %10s %11s %8s %10s %10s %9s %10s" % (
-            "robots", "succeeded", "contacts", "straight m", "route m", "converge s", "switch s",
-            "degraded s", "recover s", "cycle p99", "wall s"))
+        print(formation_table(result))
         rows = [(n, r) for n, r in result["formation"].items()]
         rows += [("%s office" % n, r) for n, r in result.get("formation_office", {}).items()]   # the office route
-        for n, r in rows:
-            wall = max((d.get("wall_s") or 0) for d in r.get("details", [{}]))
-
-            def f(key, fmt):
-                return fmt % r[key] if r.get(key) is not None else "-"
-            print("  %-8s %9s %9d %11s %10s %11s %8s %10s %10s %9s %10.0f" % (
-                n, "%d/%d" % (r["succeeded"], r["runs"]), r["contacts"], f("rms_straight_m", "%.3f"),
-                f("rms_route_m", "%.3f"), f("converge_s", "%.1f"), f("switch_s", "%.1f"), f("degraded_s", "%.1f"),
-                f("recover_s", "%.1f"), f("cycle_p99_ms", "%.1f ms"), wall))
         # the law comparison (issue 26): p95 slot error of the switch (office: of the route), the
         # closest two robots (centres - 2 radii; target >= 0.05 m), the mpc solve time
         print("\n  %-12s %16s %14s %15s %15s %16s" % ("robots", "slot p95 m", "clearance m", "mpc solve p50",

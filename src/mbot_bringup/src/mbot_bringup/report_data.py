@@ -43,6 +43,8 @@ METRICS = [
     Metric("latency_max_s", "control latency, largest", "ms", 1000, 0, "lower"),
     Metric("tf_success_rate", "tf lookup success", "%", 100, 3, "higher"),
     Metric("cycle_time_p99_ms", "controller cycle time, 99th percentile (wall)", "ms", 1, 1, "lower"),
+    Metric("cycle_overruns", "controller cycles longer than the period (overruns, all robots)", "", 1, 0, "lower"),
+    Metric("cycle_late_starts", "controller cycles started a period or more late (all robots)", "", 1, 0, "lower"),
     Metric("contacts", "contacts", "", 1, 0, "lower"),
     Metric("min_clearance_m", "closest robot-robot clearance", "m", 1, 2, "higher"),
     Metric("distance_m", "distance driven, all robots", "m", 1, 1, None),

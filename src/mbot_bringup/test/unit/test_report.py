@@ -108,6 +108,36 @@ def test_tables_give_the_measured_arrival_switch_and_loss(report):
     assert row_cells(page, "NAVIGATING")[1] == "%.1f" % spent["NAVIGATING"]
 
 
+def test_overruns_and_late_starts_stand_beside_the_cycle_time(tmp_path):
+    """The follower's overrun and late-start counters (controller.csv, newest per robot, summed)
+    are rows right below the cycle time p99 in the metrics table."""
+    from mbot_bringup.report import metrics_table
+    run = copy_run(tmp_path)
+    path = os.path.join(run, "metrics", "controller.csv")
+    with open(path) as f:
+        lines = f.read().splitlines()
+    # the fixture predates the counters (7 columns): give them counters that grow as a follower's do
+    seen, newest = {}, {}
+    out = [lines[0] + ",overruns,late_starts"]
+    for line in lines[1:]:
+        robot = line.split(",")[1]
+        seen[robot] = seen.get(robot, 0) + 1
+        counters = (0, 0) if robot == "leader" else (seen[robot] // 100, seen[robot] // 250)
+        newest[robot] = counters
+        out.append(line + ",%d,%d" % counters)
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+    overruns, late = sum(c[0] for c in newest.values()), sum(c[1] for c in newest.values())
+    assert (overruns, late) == (12, 4)   # follower_1: 620 rows, follower_2: 617
+    page = metrics_table(RunInputs(run).numbers)
+    names = [re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<tr><td class=\"l\">(.*?)</td>", page)]
+    at = names.index("controller cycle time, 99th percentile (wall)")
+    assert names[at + 1:at + 3] == ["controller cycles longer than the period (overruns, all robots)",
+                                    "controller cycles started a period or more late (all robots)"]
+    assert row_cells(page, names[at + 1])[1:] == ["-", "12"]
+    assert row_cells(page, names[at + 2])[1:] == ["-", "4"]
+
+
 def test_every_plot_is_a_png_that_shows_something(report):
     from PIL import Image
     run, page, _ = report
