@@ -434,87 +434,102 @@ def frame_scans(series, scans, i):
     return out
 
 
+class AnimationFrame(object):
+    """The animation's figure: the map, each robot's laser hits as dots (scans:
+    report_scans.read_scans, None: none), robots as discs with a heading tick, their slots as
+    dashed rings (a dotted line from each robot to its slot: its slot error), a line from the
+    leader to each follower, each robot's recent path, the state, the formation and the time as
+    the caption, and each event for a few seconds after it. draw(i) shows sample i."""
+
+    def __init__(self, run, world, colors, radius, scans=None):
+        from matplotlib.patches import Circle
+        self.run, self.colors, self.radius, self.scans = run, colors, radius, scans
+        self.series = series = Series(run)
+        self.assigned = assignments(run)
+        box = view_box(series, STYLE.margin)
+        self.fig, self.ax = fig, ax = map_figure(box, 6.0)
+        draw_map(ax, world, box)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        self.artists = {}
+        for r in series.robots:
+            trail, = ax.plot([], [], "-", color=colors[r], lw=1.2, alpha=0.6, zorder=3)
+            slot = Circle((0, 0), radius * 2.0, facecolor="none", edgecolor=colors[r], lw=1.5, ls="--", zorder=4)
+            error, = ax.plot([], [], ":", color=colors[r], lw=1.2, zorder=4)
+            link, = ax.plot([], [], "-", color="#555555", lw=1.0, zorder=4)
+            disc = Circle((0, 0), radius, facecolor=colors[r], edgecolor="black", lw=0.8, zorder=6)
+            tick, = ax.plot([], [], "-", color="black", lw=1.5, zorder=7)
+            name = ax.text(0, 0, r, fontsize=8, ha="center", va="bottom", zorder=8, color=colors[r])
+            hits, = ax.plot([], [], ".", color=colors[r], ms=2.0, alpha=0.7, zorder=2)
+            ax.add_patch(slot)
+            ax.add_patch(disc)
+            self.artists[r] = (trail, slot, error, link, disc, tick, name, hits)
+        self.caption = ax.set_title("", fontsize=10, family="monospace")
+        self.news = ax.text(0.01, 0.02, "", transform=ax.transAxes, fontsize=10, color=STYLE.mark_colors["switch"],
+                            zorder=9, bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85))
+        self.marks = event_marks(run)
+        self.speedup = 1.0   # playback speed over sim time, for the caption
+
+    def draw(self, i):
+        """Put sample i of the run into the figure's artists."""
+        series, colors, radius = self.series, self.colors, self.radius
+        t = series.t[i]
+        leader_name = series.leader[i]
+        leader = series.pose(leader_name, i)
+        a = assignment_at(self.assigned, t + series.t0)
+        slots = slot_positions(a, leader, leader_trail(series, a, i) if a is not None and a.along_path else None)
+        recent = (series.t >= t - STYLE.trail) & (series.t <= t)
+        seen = frame_scans(series, self.scans, i)
+        for r, (trail, slot, error, link, disc, tick, name, hits) in self.artists.items():
+            hits.set_data(seen[r][:, 0] if r in seen else [], seen[r][:, 1] if r in seen else [])
+            pose = series.pose(r, i)
+            lost = r in series.lost[i]
+            visible = pose is not None
+            for artist in (disc, tick, name, trail):
+                artist.set_visible(visible)
+            if visible:
+                x, y, theta = pose
+                disc.center = (x, y)
+                disc.set_facecolor("white" if lost else colors[r])
+                tick.set_data([x, x + 2.2 * radius * math.cos(theta)], [y, y + 2.2 * radius * math.sin(theta)])
+                name.set_position((x, y + 1.6 * radius))
+                name.set_text(r + (" LOST" if lost else " (leads)" if r == leader_name else ""))
+                trail.set_data(series.x[r][recent], series.y[r][recent])
+            slot.set_visible(r in slots)
+            error.set_visible(visible and r in slots)
+            if r in slots:
+                slot.center = slots[r]
+                if visible:
+                    error.set_data([pose[0], slots[r][0]], [pose[1], slots[r][1]])
+            link.set_visible(visible and leader is not None and r != leader_name and not lost)
+            if link.get_visible():
+                link.set_data([leader[0], pose[0]], [leader[1], pose[1]])
+        rms = series.slot_rms[i]
+        self.caption.set_text("t = %5.1f s  %-10s %-9s slot RMS %s  (%.1fx speed)" % (
+            t, series.state[i], a.formation if a else "", "%.2f m" % rms if math.isfinite(rms) else "  -   ",
+            self.speedup))
+        recent_marks = [m for m in self.marks if 0.0 <= t + series.t0 - m.t <= STYLE.news]
+        self.news.set_visible(bool(recent_marks))
+        if recent_marks:
+            self.news.set_text(", ".join(m.label for m in recent_marks))
+            self.news.set_color(STYLE.mark_colors.get(recent_marks[-1].kind, "#555555"))
+
+
 def write_animation(run, world, colors, path, radius, scans=None):
-    """A GIF of the run: the map, each robot's laser hits as dots (scans: report_scans.read_scans,
-    None: none), robots as discs with a heading tick, their slots as dashed
-    rings (a dotted line from each robot to its slot: its slot error), a line from the leader to
-    each follower, each robot's recent path, the state, the formation and the time as the
-    caption, and each event for a few seconds after it. Returns the number of frames."""
-    from matplotlib.patches import Circle
-    series = Series(run)
-    assigned = assignments(run)
+    """A GIF of the run (AnimationFrame), sped up to at most gif_max_frames frames. Returns the
+    number of frames."""
     plt = pyplot()
-    box = view_box(series, STYLE.margin)
-    fig, ax = map_figure(box, 6.0)
-    draw_map(ax, world, box)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    artists = {}
-    for r in series.robots:
-        trail, = ax.plot([], [], "-", color=colors[r], lw=1.2, alpha=0.6, zorder=3)
-        slot = Circle((0, 0), radius * 2.0, facecolor="none", edgecolor=colors[r], lw=1.5, ls="--", zorder=4)
-        error, = ax.plot([], [], ":", color=colors[r], lw=1.2, zorder=4)
-        link, = ax.plot([], [], "-", color="#555555", lw=1.0, zorder=4)
-        disc = Circle((0, 0), radius, facecolor=colors[r], edgecolor="black", lw=0.8, zorder=6)
-        tick, = ax.plot([], [], "-", color="black", lw=1.5, zorder=7)
-        name = ax.text(0, 0, r, fontsize=8, ha="center", va="bottom", zorder=8, color=colors[r])
-        hits, = ax.plot([], [], ".", color=colors[r], ms=2.0, alpha=0.7, zorder=2)
-        ax.add_patch(slot)
-        ax.add_patch(disc)
-        artists[r] = (trail, slot, error, link, disc, tick, name, hits)
-    caption = ax.set_title("", fontsize=10, family="monospace")
-    news = ax.text(0.01, 0.02, "", transform=ax.transAxes, fontsize=10, color=STYLE.mark_colors["switch"],
-                   zorder=9, bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85))
-    marks = event_marks(run)
+    frame = AnimationFrame(run, world, colors, radius, scans)
+    series = frame.series
     frames = animation_frames(series, STYLE.gif_max_frames)
     dt = (series.t[-1] - series.t[0]) / max(1, len(frames) - 1)
-    speedup = dt * STYLE.gif_fps
+    frame.speedup = dt * STYLE.gif_fps
     writer = gif_writer(STYLE.gif_fps)
-    with writer.saving(fig, path, STYLE.gif_width / fig.get_figwidth()):
+    with writer.saving(frame.fig, path, STYLE.gif_width / frame.fig.get_figwidth()):
         for i in frames:
-            t = series.t[i]
-            leader_name = series.leader[i]
-            leader = series.pose(leader_name, i)
-            a = assignment_at(assigned, t + series.t0)
-            slots = slot_positions(a, leader, leader_trail(series, a, i) if a is not None and a.along_path else None)
-            recent = (series.t >= t - STYLE.trail) & (series.t <= t)
-            seen = frame_scans(series, scans, i)
-            for r, (trail, slot, error, link, disc, tick, name, hits) in artists.items():
-                hits.set_data(seen[r][:, 0] if r in seen else [], seen[r][:, 1] if r in seen else [])
-                pose = series.pose(r, i)
-                lost = r in series.lost[i]
-                visible = pose is not None
-                for a in (disc, tick, name, trail):
-                    a.set_visible(visible)
-                if visible:
-                    x, y, theta = pose
-                    disc.center = (x, y)
-                    disc.set_facecolor("white" if lost else colors[r])
-                    tick.set_data([x, x + 2.2 * radius * math.cos(theta)], [y, y + 2.2 * radius * math.sin(theta)])
-                    name.set_position((x, y + 1.6 * radius))
-                    name.set_text(r + (" LOST" if lost else " (leads)" if r == leader_name else ""))
-                    trail.set_data(series.x[r][recent], series.y[r][recent])
-                slot.set_visible(r in slots)
-                error.set_visible(visible and r in slots)
-                if r in slots:
-                    slot.center = slots[r]
-                    if visible:
-                        error.set_data([pose[0], slots[r][0]], [pose[1], slots[r][1]])
-                link.set_visible(visible and leader is not None and r != leader_name and not lost)
-                if link.get_visible():
-                    link.set_data([leader[0], pose[0]], [leader[1], pose[1]])
-            a = assignment_at(assigned, t + series.t0)
-            rms = series.slot_rms[i]
-            caption.set_text("t = %5.1f s  %-10s %-9s slot RMS %s  (%.1fx speed)" % (
-                t, series.state[i], a.formation if a else "", "%.2f m" % rms if math.isfinite(rms) else "  -   ",
-                speedup))
-            recent_marks = [m for m in marks if 0.0 <= t + series.t0 - m.t <= STYLE.news]
-            news.set_visible(bool(recent_marks))
-            if recent_marks:
-                news.set_text(", ".join(m.label for m in recent_marks))
-                news.set_color(STYLE.mark_colors.get(recent_marks[-1].kind, "#555555"))
+            frame.draw(i)
             writer.grab_frame()
-    plt.close(fig)
+    plt.close(frame.fig)
     return len(frames)
 
 

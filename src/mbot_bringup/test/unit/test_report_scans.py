@@ -1,6 +1,8 @@
 """The report's animation draws each robot's laser hits from RUN_DIR/run.bag (report_scans): the
-scans are thinned, placed in the map with the robot's pose of the scan's time, and every frame of
-the recorded trio run has hits for each robot; a broken bag is one line naming it."""
+scans are thinned, placed in the map with the robot's pose of the scan's time, every frame of
+the recorded trio run has hits for each robot, and a frame drawn shows them as dots of the
+robot's colour where they are, and nothing of that colour elsewhere; a broken bag is one line
+naming it."""
 import math
 import os
 
@@ -11,9 +13,9 @@ import rospy
 from sensor_msgs.msg import LaserScan
 
 from mbot_bringup.report_data import ReportError, Series
-from mbot_bringup.report_plots import _index_at, animation_frames, frame_scans
+from mbot_bringup.report_plots import AnimationFrame, _index_at, animation_frames, frame_scans
 from mbot_bringup.report_scans import LASER_X, read_scans
-from mbot_follower.metrics import load_run
+from mbot_follower.metrics import Event, RobotSample, Run, Sample, load_run
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FIXTURE = os.path.join(HERE, "..", "fixtures", "run_trio")
@@ -79,3 +81,49 @@ def test_a_broken_bag_is_one_line_naming_it(tmp_path):
         read_scans(str(bag), ["leader"])
     assert str(error.value).startswith("%s: cannot read the scans: " % bag)
     assert "\n" not in str(error.value)
+
+
+def test_a_frame_shows_the_hits_as_dots_of_the_robots_colour_where_they_are():
+    from mbot_common.paths import resolve_world
+    from mbot_common.world import load_world
+    nan = float("nan")
+    poses = {"a": (0.0, 0.0, math.pi / 2), "b": (4.0, 3.0, 0.0)}   # a faces +y; b has no scan
+    run = Run()
+    run.robots = ["a", "b"]
+    run.events = [Event(10.0, "state", "NAVIGATING", "", nan, nan)]
+    for t in (10.0, 10.2):
+        robots = dict((r, RobotSample(x, y, th, nan, nan, 0.0, 0.0)) for r, (x, y, th) in poses.items())
+        run.samples.append(Sample(t, "NAVIGATING", "a", "", (), nan, nan, nan, nan, nan, nan, nan, nan, "", robots))
+    # a's scan at 10.0 s: three hits in its own frame (x ahead), so at (-0.5, 2), (1.5, 1), (2, 3) in the map
+    hits = np.array([[2.0, 0.5], [1.0, -1.5], [3.0, -2.0]])
+    scans = {"a": ([10.0], [hits]), "b": ([], [])}
+    colors = {"a": (0.0, 0.4, 0.8), "b": (0.8, 0.2, 0.2)}
+    frame = AnimationFrame(run, load_world(resolve_world("field")), colors, 0.15, scans)
+    frame.draw(1)
+    fig, ax = frame.fig, frame.ax
+    fig.canvas.draw()
+    image = np.asarray(fig.canvas.buffer_rgba())[:, :, :3] / 255.0
+    height = image.shape[0]
+    dot = 0.7 * np.array(colors["a"]) + 0.3   # the dots: alpha 0.7 on the free (white) map
+
+    def near(xy, color, tolerance=0.08):
+        """Pixels within 2 px of the map point xy whose colour is within tolerance of color."""
+        px, py = ax.transData.transform(xy)
+        row, col = int(round(height - py)), int(round(px))
+        patch = image[row - 2:row + 3, col - 2:col + 3]
+        return int(np.sum(np.max(np.abs(patch - color), axis=2) < tolerance))
+
+    for x, y in [(-0.5, 2.0), (1.5, 1.0), (2.0, 3.0)]:
+        assert near((x, y), dot) >= 1, (x, y)
+    # the same distances in other directions (no beam hit there), and around b (no scan): no dot
+    for x, y in [(0.5, -0.7), (-0.7, 0.7), (2.5, 0.0), (1.0, 3.5), (3.0, 2.0), (4.5, 2.0)]:
+        assert near((x, y), dot) == 0, (x, y)
+        assert near((x, y), np.array([1.0, 1.0, 1.0]), 0.02) == 25, (x, y)   # white: the free map only
+    # with no scans the same frame has no dot at the hits
+    frame = AnimationFrame(run, load_world(resolve_world("field")), colors, 0.15, None)
+    frame.draw(1)
+    fig, ax = frame.fig, frame.ax
+    fig.canvas.draw()
+    image = np.asarray(fig.canvas.buffer_rgba())[:, :, :3] / 255.0
+    for x, y in [(-0.5, 2.0), (1.5, 1.0), (2.0, 3.0)]:
+        assert near((x, y), dot) == 0, (x, y)
