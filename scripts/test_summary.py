@@ -12,12 +12,17 @@ counts only when it failed (the node crashed or timed out before writing its res
 no test counts twice.
 
 --expect FILE: the result files a complete run has (one name a line, as found under the DIRs,
-e.g. `mbot_sim/gtest-test_world.xml`). A test that a partial build loses (a guard in a
-CMakeLists, a target that failed to build) writes no result and reads as nothing at all; with the
-list it is a failure naming the missing file. Every rostest file under `--src`'s packages
-(`src/<pkg>/test/**/*.test`) and `--system` is expected too, without a line. A skipped test case
-is a failure, and so is a result file that nothing expects: a new gtest is added to the list in
-the same commit.
+e.g. `mbot_sim/gtest-test_world.xml`), each optionally followed by the least number of test
+cases it must hold (`mbot_sim/gtest-test_world.xml 43`). A test that a partial build loses (a
+guard in a CMakeLists, a target that failed to build) writes no result and reads as nothing at
+all; with the list it is a failure naming the missing file. A file with fewer cases than its
+minimum (a deleted or #if-ed TEST, a pytest file no longer collected: all pytest cases are in
+one pytest.xml) is a failure naming the file, the minimum and the count. Every rostest file
+under `--src`'s packages (`src/<pkg>/test/**/*.test`) and `--system` is expected too, without a
+line (its cases are in the rosunit-*.xml of its test node, which a line can give a minimum). A
+skipped test case is a failure, and so is a result file that nothing expects: a new gtest is
+added to the list in the same commit. The cases of each kind (pytest, gtest, rostest, lint) are
+printed before the totals.
 """
 import os
 import sys
@@ -123,11 +128,53 @@ def completeness(found, expected, src, system=None):
     return failures
 
 
+def read_expected(path):
+    """{result name: least number of test cases, or None} of an expected list: one result a line,
+    optionally its minimum after a space; lines starting with # are comments. ValueError naming
+    the file and the line for anything else."""
+    expected = {}
+    with open(path) as f:
+        for number, line in enumerate(f, start=1):
+            fields = line.split()
+            if not fields or fields[0].startswith("#"):
+                continue
+            if len(fields) > 2 or (len(fields) == 2 and not fields[1].isdigit()):
+                raise ValueError("%s:%d: expected 'RESULT_FILE [MIN_CASES]' (MIN_CASES a whole number), got %r"
+                                 % (path, number, line.strip()))
+            expected[fields[0]] = int(fields[1]) if len(fields) == 2 else None
+    return expected
+
+
+def kind(name):
+    """The kind of test a result file holds: gtest, rostest (its rostest-*.xml and the rosunit-*.xml
+    of its node), lint, or pytest (pytest.xml, fleet_hosts.xml)."""
+    base = os.path.basename(name)
+    if base.startswith("gtest-"):
+        return "gtest"
+    if base.startswith(("rostest-", "rosunit-")):
+        return "rostest"
+    return "lint" if base == "lint.xml" else "pytest"
+
+
+def too_few(cases, minimums, listing):
+    """Failures (name, message) of the result files with fewer test cases than their minimum.
+    cases: {result name: number of cases}; minimums: {result name: least number or None};
+    listing: the expected list's file, for the message."""
+    return [(name, "%d test cases, fewer than the %d that %s expects: a test was lost (deleted, #if-ed out, "
+                   "renamed or not collected); if that was meant, lower the minimum there"
+             % (cases[name], least, listing))
+            for name, least in sorted(minimums.items()) if least is not None and name in cases and cases[name] < least]
+
+
 def main(argv):
     expected, src = None, None
     if argv[:1] == ["--expect"]:
-        with open(argv[1]) as f:
-            expected = [line.strip() for line in f if line.strip() and not line.startswith("#")]
+        listing = os.path.relpath(argv[1])
+        try:
+            expected = read_expected(argv[1])
+        except ValueError as error:
+            print(error, file=sys.stderr)
+            return 2
         argv = argv[2:]
         if argv[:1] == ["--src"]:
             src, argv = argv[1], argv[2:]
@@ -138,9 +185,13 @@ def main(argv):
     totals = [0, 0, 0]
     details = []
     found = []
+    cases = {}                                               # result name: test cases in it
+    by_kind = dict((k, 0) for k in ("pytest", "gtest", "rostest", "lint"))
     for path in result_files(dirs):
         found.append(result_name(path, dirs))
         p, f, s, failures = count(path)
+        cases[found[-1]] = cases.get(found[-1], 0) + p + f + s
+        by_kind[kind(found[-1])] += p + f + s
         if expected is not None and s:
             failures.append(("%s (%d skipped)" % (found[-1], s), "a skipped test is a test that did not run"))
             f += 1
@@ -153,7 +204,7 @@ def main(argv):
             print("      FAILED: %s" % name)
             details.append((name, message))
     if expected is not None:
-        for name, message in completeness(found, expected, src, system):
+        for name, message in completeness(found, expected, src, system) + too_few(cases, expected, listing):
             totals[1] += 1
             print("      FAILED: %s" % name)
             details.append((name, message))
@@ -163,6 +214,7 @@ def main(argv):
         for line in message_tail(message):
             print("    " + line[:200])
     print()
+    print("test cases by kind: " + ", ".join("%s %d" % item for item in by_kind.items()))
     print("%d passed, %d failed, %d skipped" % tuple(totals))
     if totals[0] + totals[1] == 0:
         print("no test ran", file=sys.stderr)

@@ -1,5 +1,6 @@
 """scripts/test_summary.py counts JUnit results from pytest, gtest and rostest correctly."""
 import os
+import re
 import subprocess
 import sys
 
@@ -138,3 +139,82 @@ def test_a_rostest_file_without_a_result_or_a_result_nothing_expects_fails_the_r
     assert code == 1
     assert "pkg/rostest-test_rostest_new_check.xml" in out and "is not registered (add_rostest)" in out
     assert "pkg/gtest-test_new.xml" in out and "does not list" in out
+
+
+# --- minimum case counts: a result file that lost cases is a failed run ------------------------------
+
+def cases_xml(n):
+    return ('<?xml version="1.0"?>\n<testsuite name="s" tests="%d">%s</testsuite>'
+            % (n, "".join('<testcase classname="S" name="t%d"/>' % k for k in range(n))))
+
+
+def test_a_file_with_fewer_cases_than_its_minimum_fails_the_run_naming_it_the_minimum_and_the_count(tmp_path):
+    code, out = run_expecting(tmp_path, {"pytest.xml": cases_xml(940), "pkg/gtest-test_a.xml": cases_xml(5)},
+                              ["pytest.xml 945", "pkg/gtest-test_a.xml 5"])
+    assert code == 1, out
+    assert "FAILED: pytest.xml" in out
+    assert "940 test cases, fewer than the 945 that" in out and "expected.txt expects" in out
+    assert "FAILED: pkg/gtest-test_a.xml" not in out   # 5 of 5: enough
+    assert out.strip().splitlines()[-1] == "945 passed, 1 failed, 0 skipped"
+
+
+def test_as_many_or_more_cases_than_the_minimum_and_a_line_without_one_pass(tmp_path):
+    code, out = run_expecting(tmp_path, {"pytest.xml": cases_xml(950), "pkg/gtest-test_a.xml": cases_xml(5),
+                                         "pkg/gtest-test_b.xml": cases_xml(1)},
+                              ["pytest.xml 945", "pkg/gtest-test_a.xml 5", "pkg/gtest-test_b.xml"])
+    assert code == 0, out
+    assert out.strip().splitlines()[-1] == "956 passed, 0 failed, 0 skipped"
+
+
+def test_a_rostests_cases_are_checked_through_its_nodes_rosunit_file(tmp_path):
+    results = {"pkg/rostest-test_sim.xml": ROSTEST_NODE_RAN, "pkg/rosunit-sim.xml": ROSTEST_XML}
+    code, out = run_expecting(tmp_path, results, ["pkg/rosunit-sim.xml 3"], ["pkg/test/sim.test"])
+    assert code == 1 and "2 test cases, fewer than the 3 that" in out
+    code, out = run_expecting(tmp_path, results, ["pkg/rosunit-sim.xml 2"], ["pkg/test/sim.test"])
+    assert code == 0, out
+
+
+def test_the_cases_of_each_kind_are_printed_before_the_totals(tmp_path):
+    results = {"pytest.xml": cases_xml(7), "fleet_hosts.xml": cases_xml(1), "lint.xml": cases_xml(3),
+               "pkg/gtest-test_a.xml": cases_xml(4), "pkg/gtest-test_b.xml": cases_xml(2),
+               "pkg/rostest-test_sim.xml": ROSTEST_NODE_RAN, "pkg/rosunit-sim.xml": ROSTEST_XML}
+    code, out = run_expecting(tmp_path, results, ["pytest.xml", "fleet_hosts.xml", "lint.xml", "pkg/gtest-test_a.xml",
+                                                  "pkg/gtest-test_b.xml"], ["pkg/test/sim.test"])
+    assert code == 0, out
+    lines = out.strip().splitlines()
+    assert lines[-2] == "test cases by kind: pytest 8, gtest 6, rostest 2, lint 3"
+    assert lines[-1] == "19 passed, 0 failed, 0 skipped"
+
+
+def test_a_bad_line_in_the_expected_list_is_an_error_naming_it(tmp_path):
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "pytest.xml").write_text(cases_xml(1))
+    for line in ("pytest.xml many", "pytest.xml 3 4", "pytest.xml -1"):
+        listing = tmp_path / "expected.txt"
+        listing.write_text("# comment\nlint.xml\n%s\n" % line)
+        proc = subprocess.run([sys.executable, SUMMARY, "--expect", str(listing), str(tmp_path / "results")],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        assert proc.returncode == 2, line
+        assert proc.stderr.strip() == "%s:3: expected 'RESULT_FILE [MIN_CASES]' (MIN_CASES a whole number), got %r" % (
+            listing, line)
+
+
+def test_the_projects_list_reads_and_each_rostest_line_names_a_test_node_of_a_test_file():
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    try:
+        from test_summary import read_expected
+    finally:
+        sys.path.pop(0)
+    expected = read_expected(os.path.join(ROOT, "tests", "expected_results.txt"))
+    assert expected["pytest.xml"] >= 900
+    nodes = set()
+    for top in [os.path.join(ROOT, "src"), os.path.join(ROOT, "tests", "rostest")]:
+        for root, _, files in os.walk(top):
+            for name in files:
+                if name.endswith(".test"):
+                    with open(os.path.join(root, name)) as f:
+                        nodes.update(re.findall(r'test-name="([^"]+)"', f.read()))
+    rosunit = [name for name in expected if "/rosunit-" in name]
+    assert len(rosunit) >= 60
+    for name in rosunit:
+        assert name.split("/rosunit-")[1][:-len(".xml")] in nodes, name
