@@ -20,6 +20,8 @@
 #include <boost/make_shared.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 
 namespace mbot_sim
 {
@@ -53,6 +55,7 @@ StageParams readStageParams(const ros::NodeHandle& pnh)
   pnh.param("clock_rate", p.clock_rate, 0.0);
   if (!(p.clock_rate >= 0.0))
     throw StartupError(pnh.resolveName("clock_rate") + ": expected a number >= 0 [Hz] (0: /clock after every step)");
+  pnh.param("lockstep_report", p.lockstep_report, std::string());
   pnh.param("wheel_tf_rate", p.wheel_tf_rate, 10.0);
   if (!(p.wheel_tf_rate >= 0.0))
     throw StartupError(pnh.resolveName("wheel_tf_rate") + ": expected a number >= 0 [Hz] (0: no wheel transforms)");
@@ -307,7 +310,8 @@ void StageRos::publishAppliedCommands()
 void StageRos::run()
 {
   ros::CallbackQueue& queue = *ros::getGlobalCallbackQueue();
-  ros::WallTime anchor_wall = ros::WallTime::now();
+  const ros::WallTime run_started = ros::WallTime::now();
+  ros::WallTime anchor_wall = run_started;
   double anchor_sim = world_->time();
   next_boundary_ = (std::floor(world_->time() / params_.lockstep_period) + 1.0) * params_.lockstep_period;
 
@@ -382,8 +386,19 @@ void StageRos::run()
     }
   }
   if (params_.lockstep)  // for benchmarks: what the waits cost over the whole run
-    ROS_INFO("stage_node: lockstep: %ld boundaries, %ld wall timeouts (%g s wall each)", boundary_count_,
-             lockstep_timeouts_total_, params_.lockstep_wall_timeout);
+  {
+    char head[160];
+    std::snprintf(head, sizeof head, "stage_node: lockstep: %ld boundaries, %ld wall timeouts (%g s wall each); ",
+                  boundary_count_, lockstep_timeouts_total_, params_.lockstep_wall_timeout);
+    const std::string summary = head + lockstepWaitSummary((ros::WallTime::now() - run_started).toSec());
+    ROS_INFO("%s", summary.c_str());
+    if (!params_.lockstep_report.empty())  // the screen may be gone at shutdown: a file stays
+    {
+      std::ofstream report(params_.lockstep_report);
+      report << summary << "\n";
+      if (!report) ROS_ERROR("stage_node: ~lockstep_report: cannot write %s", params_.lockstep_report.c_str());
+    }
+  }
 }
 
 }  // namespace mbot_sim

@@ -12,7 +12,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mbot_sim
 {
@@ -74,6 +77,8 @@ bool StageRos::waitForControllers()
   const auto paced = [this](const Pacer& p) {
     return p.ignored || p.stamp + params_.lockstep_pacer_lag >= world_->time() - 1e-9;
   };
+  const ros::WallTime started = ros::WallTime::now();
+  std::vector<std::string> blockers;  // who sim time waited for in the last round (the last to answer)
   while (true)
   {
     if (!ros::ok() || paused_) return false;
@@ -83,6 +88,14 @@ bool StageRos::waitForControllers()
     for (const auto& p : pacers_)
       if (!paced(p.second)) all_answered = false;
     if (all_answered) break;
+    blockers.clear();
+    for (const auto& io : io_)
+    {
+      if (io && commandLate(*io)) blockers.push_back(io->name + " cmd_vel");
+      if (io && !localized(*io)) blockers.push_back(io->name + " localization");
+    }
+    for (const auto& p : pacers_)
+      if (!paced(p.second)) blockers.push_back(p.first + " heartbeat");
     const ros::WallTime wall_now = ros::WallTime::now();
     bool pacer_moving = false;
     for (const auto& p : pacers_)
@@ -133,7 +146,33 @@ bool StageRos::waitForControllers()
   for (auto& io : io_)  // each cmd_vel releases one boundary
     if (io && io->cmd_boundary >= boundary_count_ - 1) io->cmd_unused = false;
   boundary_wait_pending_ = false;
+  if (!blockers.empty())
+  {
+    // The wait is charged to the last to answer: what a faster fleet has to speed up.
+    const double waited = (ros::WallTime::now() - started).toSec();
+    lockstep_wait_total_ += waited;
+    for (const std::string& name : blockers) lockstep_wait_by_[name] += waited / blockers.size();
+  }
   return true;
+}
+
+/// Lockstep: the wall time spent waiting at boundaries, and who was waited for most (logged at the end).
+std::string StageRos::lockstepWaitSummary(double run_wall) const
+{
+  std::vector<std::pair<double, std::string>> by_time;
+  for (const auto& entry : lockstep_wait_by_) by_time.emplace_back(entry.second, entry.first);
+  std::sort(by_time.rbegin(), by_time.rend());
+  char line[160];
+  std::snprintf(line, sizeof line, "%.1f s of %.1f s wall waiting at boundaries (%.0f %%)", lockstep_wait_total_,
+                run_wall, run_wall > 0.0 ? 100.0 * lockstep_wait_total_ / run_wall : 0.0);
+  std::string text = line;
+  for (std::size_t i = 0; i < by_time.size() && i < 6; ++i)
+  {
+    std::snprintf(line, sizeof line, "%s %s %.1f s", i == 0 ? "; the last to answer:" : ",", by_time[i].second.c_str(),
+                  by_time[i].first);
+    text += line;
+  }
+  return text;
 }
 
 /// Lockstep: this robot's localization is at most ~lockstep_localization_lag behind sim time.

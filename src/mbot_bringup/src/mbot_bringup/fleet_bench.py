@@ -160,8 +160,12 @@ def run_one(scenario, robots, run_dir, log=sys.stderr):
     command = ["/usr/bin/python3", "-m", "mbot_bringup.scenario_runner", path, "--run-dir", run_dir, "--no-rviz",
                "--no-record"]
     started = time.time()
+    # the simulator writes where its lockstep waited, and for whom, when it stops (mbot_sim README)
+    lockstep_report = os.path.abspath(run_dir + ".lockstep.txt")
+    if os.path.exists(lockstep_report):
+        os.remove(lockstep_report)
     runner = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-                              bufsize=1)
+                              bufsize=1, env=dict(os.environ, MBOT_LOCKSTEP_REPORT=lockstep_report))
     tree = ProcessTree(runner.pid)
     marks = {}
     lines = []
@@ -185,6 +189,11 @@ def run_one(scenario, robots, run_dir, log=sys.stderr):
         with open(os.path.join(run_dir, "criteria.json")) as f:
             facts = json.load(f)["facts"]
     except (OSError, ValueError, KeyError):
+        pass
+    try:
+        with open(lockstep_report) as f:
+            result["lockstep"] = f.read().strip()
+    except OSError:
         pass
     sim_s = facts.get("end_s") or 0.0
     result["whole_run"] = figures(robots, sim_s, ended - started, tree.by_kind())

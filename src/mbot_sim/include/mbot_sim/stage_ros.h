@@ -77,6 +77,7 @@ struct StageParams
                                                 ///< map -> <ns>/odom by this much (their transform_tolerance) [s]
   double lockstep_pacer_lag = 0.3;              ///< ~lockstep_pacer_lag: a node that paces sim time (a heartbeat on
                                                 ///< /lockstep/heartbeat) may lag it this much [s sim]
+  std::string lockstep_report;                  ///< ~lockstep_report: at the end, the waits' summary to this file
 };
 
 /// @brief Read the private parameters. @throws StartupError for a missing world or a bad value
@@ -215,9 +216,12 @@ private:
     bool ignored = false;
     ros::WallTime moved;  ///< wall time the stamp last moved on
   };
-  std::map<std::string, Pacer> pacers_;  ///< by node name (the heartbeat's frame_id)
-  long lockstep_timeouts_ = 0;           ///< wall timeouts since the last warning
-  long lockstep_timeouts_total_ = 0;     ///< wall timeouts since the start (logged at the end)
+  std::map<std::string, Pacer> pacers_;             ///< by node name (the heartbeat's frame_id)
+  long lockstep_timeouts_ = 0;                      ///< wall timeouts since the last warning
+  long lockstep_timeouts_total_ = 0;                ///< wall timeouts since the start (logged at the end)
+  double lockstep_wait_total_ = 0.0;                ///< wall time spent waiting at boundaries [s]
+  std::map<std::string, double> lockstep_wait_by_;  ///< ... charged to the last to answer [s]
+  std::string lockstepWaitSummary(double run_wall) const;
   ros::WallTime last_lockstep_warning_;
 };
 
