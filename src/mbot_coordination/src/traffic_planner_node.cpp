@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <set>
@@ -421,7 +422,12 @@ private:
       if (!pose(e.name, p))
       {
         if (e.unseen_since < 0) e.unseen_since = t;
-        if (t - e.unseen_since > lost_timeout_) fail(e, "killed (no pose for " + std::to_string(lost_timeout_) + " s)");
+        if (t - e.unseen_since > lost_timeout_)
+        {
+          char why[64];
+          std::snprintf(why, sizeof(why), "killed (no pose for %.1f s)", lost_timeout_);
+          fail(e, why);
+        }
         continue;
       }
       e.unseen_since = -1.0;
@@ -536,15 +542,22 @@ private:
   // Late robots: re-plan them and the robots whose remaining plans share a cell with theirs.
   void replanLate(const std::vector<size_t>& late)
   {
-    std::set<size_t> group(late.begin(), late.end());
+    std::set<size_t> group;
     for (size_t i : late)
       for (size_t j = 0; j < execs_.size(); ++j)
       {
         const Exec &a = execs_[i], &b = execs_[j];
         if (j == i || b.state != Exec::ACTIVE) continue;
         for (size_t k = a.progress; k < a.path.size() && !group.count(j); ++k)
-          if (std::find(b.path.begin() + b.progress, b.path.end(), a.path[k]) != b.path.end()) group.insert(j);
+          if (std::find(b.path.begin() + b.progress, b.path.end(), a.path[k]) != b.path.end())
+          {
+            group.insert(i);
+            group.insert(j);
+          }
       }
+    // A late robot whose remaining cells no other robot visits delays nobody: it drives on (a
+    // re-plan would only stop it).
+    if (group.empty()) return;
     std::string names;
     for (size_t i : group) names += (names.empty() ? "" : ", ") + execs_[i].name;
     const Exec& first = execs_[late[0]];

@@ -3,7 +3,8 @@
 through /fleet/goals. Bad goal sets first: each is aborted with its problem named. Then both robots
 arrive at their goals, the simulator reports no contact involving them, their timed plans are
 published, and the delay over driving alone (the robot's own shortest path at the planner's
-nominal speed) stays within the issue's 15 s."""
+nominal speed) stays within the issue's 15 s. Last, robot_1 is removed from the simulator on its
+way to a new goal: the result reports it killed and robot_0 still arrives."""
 import math
 import unittest
 
@@ -13,6 +14,7 @@ import rostest
 from actionlib_msgs.msg import GoalStatus
 from geometry_msgs.msg import Pose2D
 from mbot_msgs.msg import Contact, FleetGoalsAction, FleetGoalsGoal, RobotStates
+from mbot_msgs.srv import RemoveRobot
 from move_base_msgs.msg import MoveBaseAction
 from nav_msgs.msg import Path
 from visualization_msgs.msg import MarkerArray
@@ -116,6 +118,27 @@ class TrafficSwap(unittest.TestCase):
             rospy.loginfo("traffic_swap: %s took %.1f s, alone %.1f s planned: added delay %.1f s",
                           name, took, alone, took - alone)
             self.assertLessEqual(took - alone, 15.0, summary)
+
+    def test_3_killed_robot_reported(self):
+        # after the swap: robot_0 near x = 9, robot_1 near x = -9; robot_1 is removed on its way
+        fleet = Fleet()
+        while len(fleet.poses) < 2 and not rospy.is_shutdown():
+            rospy.sleep(0.1)
+        goals = {"robot_0": (6.0, 0.0, math.pi), "robot_1": (-6.0, 0.0, 0.0)}
+        self.client.send_goal(goal_set(sorted(goals.items())))
+        rospy.sleep(3.0)
+        rospy.wait_for_service("/remove_robot", timeout=30.0)
+        self.assertTrue(rospy.ServiceProxy("/remove_robot", RemoveRobot)(name="robot_1").success)
+        self.assertTrue(self.client.wait_for_result(rospy.Duration(TIMEOUT)))
+        result = self.client.get_result()
+        rospy.loginfo("traffic_swap: with robot_1 removed: state %d, %s", self.client.get_state(), result)
+        self.assertEqual(self.client.get_state(), GoalStatus.ABORTED, result)
+        self.assertEqual(list(result.robots), ["robot_0", "robot_1"])
+        self.assertEqual(list(result.reached), [True, False], result)
+        self.assertTrue(result.reasons[1].startswith("killed"), result)
+        self.assertIn("robot_1: killed", result.message)
+        x, y, _ = goals["robot_0"]
+        self.assertLess(math.hypot(fleet.poses["robot_0"][0] - x, fleet.poses["robot_0"][1] - y), 0.15, result)
 
 
 if __name__ == "__main__":
