@@ -1,6 +1,8 @@
 // The iterated point-to-plane update on a synthetic room, and the estimator's answers to bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "mbot_lio/estimator.h"
 #include "mbot_lio/so3.h"
 #include "synthetic_room.h"
@@ -83,6 +85,38 @@ TEST(Update, NoMatchesKeepsThePrediction)
   const UpdateReport rep = est.update({Eigen::Vector3d(1, 0, 0)});
   EXPECT_EQ(rep.matches, 0);
   EXPECT_EQ(est.state().p, x.p);
+}
+
+// The map's two trees (main + recent, the ikd-tree's stand-in) answer as one: k nearest against a
+// brute-force search after batches that leave points in both trees, and one point per voxel.
+TEST(LocalMap, NearestOfBothTreesMatchesBruteForce)
+{
+  LocalMap map(1e-4, 500, 0.3);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-5.0, 5.0);
+  std::vector<Eigen::Vector3d> all;
+  for (int batch = 0; batch < 6; ++batch)  // ends with 1500 points in the main tree, 300 in the recent
+  {
+    std::vector<Eigen::Vector3d> pts;
+    for (int i = 0; i < 300; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
+    ASSERT_EQ(map.add(pts), pts.size());
+    all.insert(all.end(), pts.begin(), pts.end());
+  }
+  ASSERT_EQ(map.size(), all.size());
+  std::vector<Eigen::Vector3d> nb;
+  std::vector<float> d2;
+  for (int q = 0; q < 200; ++q)
+  {
+    const Eigen::Vector3d p(u(rng), u(rng), u(rng));
+    ASSERT_TRUE(map.nearest(p, 5, nb, d2));
+    std::vector<double> brute;
+    for (const auto& a : all) brute.push_back((a - p).squaredNorm());
+    std::sort(brute.begin(), brute.end());
+    for (int j = 0; j < 5; ++j) EXPECT_NEAR(d2[j], brute[j], 1e-4 * (1.0 + brute[j])) << "query " << q;
+  }
+  LocalMap coarse(0.5);
+  EXPECT_EQ(
+      coarse.add({Eigen::Vector3d(0.1, 0.1, 0.1), Eigen::Vector3d(0.2, 0.2, 0.2), Eigen::Vector3d(0.6, 0.1, 0.1)}), 2u);
 }
 
 // NaN IMU sample, a cloud without per-point times, out-of-order stamps, mismatched times, no IMU:
