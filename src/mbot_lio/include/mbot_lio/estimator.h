@@ -65,7 +65,8 @@ class Estimator
 public:
   explicit Estimator(const Options& options = Options());
 
-  // Starts at time t with the IMU frame's pose and velocity (start covariance from Options).
+  // Starts at time t with the IMU frame's pose and velocity (start covariance from Options or P, whose
+  // diagonal must be positive). Throws on non-finite input.
   void initialize(double t, const State& x);
   void initialize(double t, const State& x, const Cov& P);
   bool initialized() const { return initialized_; }

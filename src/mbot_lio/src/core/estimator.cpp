@@ -41,6 +41,10 @@ void Estimator::initialize(double t, const State& x, const Cov& P)
 {
   if (!std::isfinite(t) || !x.R.allFinite() || !x.p.allFinite() || !x.v.allFinite() || !P.allFinite())
     throw std::invalid_argument("mbot_lio: initialize() with a non-finite time, state or covariance");
+  if ((P.diagonal().array() <= 0.0).any())
+    throw std::invalid_argument(
+        "mbot_lio: initialize() with a covariance whose diagonal is not positive (the update "
+        "inverts it)");
   t_ = t;
   x_ = x;
   P_ = P;

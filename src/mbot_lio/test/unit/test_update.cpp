@@ -133,6 +133,8 @@ TEST(BadInput, ClearErrorsAndTheLastGoodStateIsKept)
   EXPECT_THROW(est.addFrame(LidarFrame()), std::invalid_argument);  // before initialize()
   State x0;
   x0.p = truth.p;
+  EXPECT_THROW(est.initialize(0.0, x0, Cov::Zero()), std::invalid_argument);  // not invertible
+  EXPECT_FALSE(est.initialized());
   est.initialize(0.0, x0);
   for (int k = 0; k <= 24; ++k) est.addImu(mbot_lio_test::trueImu(still, k * 0.005, kGravity));
   est.addFrame(
