@@ -21,16 +21,6 @@ def start_wall(robots):
     return START_WALL + START_WALL_PER_ROBOT * max(0, robots - START_ROBOTS)
 
 
-def free_port():
-    import socket
-
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
 def prepare_run_dir(run_dir):
     """An empty run dir: a previous run's (it has scenario.yaml) is cleared; anything else that
     is not empty is refused, so a wrong --run-dir never deletes someone's files."""

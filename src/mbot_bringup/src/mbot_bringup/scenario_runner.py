@@ -31,9 +31,10 @@ import time
 
 from mbot_bringup.console import say
 from mbot_bringup.fleet_launch import (START_ROBOTS, START_WALL, START_WALL_PER_ROBOT, WALL_PER_SIM,  # noqa: F401
-                                       FleetLaunch, free_port, prepare_run_dir, start_wall)
+                                       FleetLaunch, prepare_run_dir, start_wall)
 from mbot_bringup.scenario import check_against_world, load_scenario, summary_lines
 from mbot_bringup.scenario_judge import judge, write_criteria
+from mbot_common.net import free_port
 from mbot_bringup.scenario_player import (STATE_EVENTS, STATUS_PERIOD, SUCCEEDED, TERMINAL,  # noqa: F401
                                           ScenarioPlayer, round_ended)
 from mbot_bringup.scenario_screenshots import Screenshots, SimPause, view_drawn  # noqa: F401

@@ -22,7 +22,7 @@ import pytest
 import yaml
 
 from mbot_bringup.fleet_rviz import write_fleet_view
-from mbot_bringup.scenario_runner import free_port
+from mbot_common.net import free_port
 from mbot_bringup.screenshot import looks_rendered
 from mbot_common.paths import resolve_world
 from mbot_common.world import load_world

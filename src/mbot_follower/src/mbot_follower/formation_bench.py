@@ -433,7 +433,8 @@ def run_one(n, seed, out_dir, log, office=False, law=LAWS[0]):
     """Launch the fleet for (n, seed) with the followers' control law `law` on a private master,
     drive it (office: the office route), stop it. Returns measures."""
     from mbot_common.paths import find_maps_directory
-    from mbot_navigation.nav_trial import free_port, stop, wait_for_sim_time
+    from mbot_common.net import free_port
+    from mbot_navigation.nav_trial import stop, wait_for_sim_time
 
     suffix = "" if law == LAWS[0] else "_" + law
     run_dir = os.path.join(out_dir, "%sn%d_seed%d%s" % ("office_" if office else "", n, seed, suffix))

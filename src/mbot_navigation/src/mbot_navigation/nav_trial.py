@@ -36,13 +36,13 @@ import json
 import math
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
 
 import numpy as np
 
+from mbot_common.net import free_port
 from mbot_common.world import load_world
 from mbot_navigation import grid_paths
 
@@ -148,12 +148,6 @@ def summary(outcomes, contacts, sim_seconds, wall_seconds, robots=1):
             "wall_seconds": round(wall_seconds, 1),
             "robots": robots,
             "mean_goal_s": round(sum(times) / len(times), 1) if times else None}
-
-
-def free_port():
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("localhost", 0))
-        return s.getsockname()[1]
 
 
 def run(args, log):
