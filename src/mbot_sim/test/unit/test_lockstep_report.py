@@ -5,20 +5,15 @@ boundaries come every 0.05 s of sim time: nearly all the run is waiting, for rob
 import os
 import re
 import signal
-import socket
 import subprocess
 import time
 
 import pytest
 
+from mbot_common.net import free_port
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORLD = os.path.join(HERE, "..", "fixtures", "cmdpose.world.yaml")
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def stage_node():
@@ -39,6 +34,22 @@ def stop(process, sig=signal.SIGINT, timeout=20.0):
             process.wait()
 
 
+def wait_for(master_uri, what, condition, process, timeout=60.0):
+    """Until condition(master) holds: a starved machine takes seconds to start a ROS process."""
+    import rosgraph.masterapi
+
+    master = rosgraph.masterapi.Master("/test_lockstep_report", master_uri=master_uri)
+    deadline = time.time() + timeout
+    while time.time() < deadline and process.poll() is None:
+        try:
+            if condition(master):
+                return
+        except Exception:   # the master is still starting
+            pass
+        time.sleep(0.2)
+    pytest.fail("%s: not after %.0f s wall (its process: exit %s)" % (what, timeout, process.poll()))
+
+
 def test_the_report_names_the_robot_whose_commands_sim_time_waited_for(tmp_path):
     port = free_port()
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=str(tmp_path))
@@ -47,13 +58,16 @@ def test_the_report_names_the_robot_whose_commands_sim_time_waited_for(tmp_path)
                               stderr=subprocess.DEVNULL)
     sim = command = None
     try:
+        wait_for(env["ROS_MASTER_URI"], "the master", lambda m: m.getPid(), master)
         sim = subprocess.Popen([stage_node(), "_world:=" + WORLD, "_lockstep:=true", "_real_time_factor:=0",
                                 "_lockstep_report:=" + str(report)], env=env, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
         command = subprocess.Popen(["rostopic", "pub", "-r", "5", "/robot_0/cmd_vel", "geometry_msgs/Twist",
                                     "{linear: {x: 0.1}}"], env=env, stdout=subprocess.DEVNULL,
                                    stderr=subprocess.DEVNULL)
-        time.sleep(8.0)   # wall: the command's publisher connects, then about 20 boundaries a wait each
+        wait_for(env["ROS_MASTER_URI"], "a publisher on /robot_0/cmd_vel",
+                 lambda m: any(t == "/robot_0/cmd_vel" and nodes for t, nodes in m.getSystemState()[0]), command)
+        time.sleep(5.0)   # wall: about 25 commands, a boundary and a wait each
         assert sim.poll() is None, "stage_node stopped early (exit %s)" % sim.returncode
         stop(sim)
         text = report.read_text()
