@@ -482,6 +482,20 @@ def test_bad_config_and_bad_files_name_the_problem(tmp_path):
         RunWriter(str(tmp_path / "metrics.csv" / "sub"))
 
 
+def test_a_row_the_collector_is_still_writing_is_not_read_but_a_short_complete_row_is_an_error(tmp_path):
+    # scenario_check read metrics.csv while the collector appended: "line 9116: 13 cells, expected 38".
+    c = loss_and_rejoin_run()
+    RunWriter(str(tmp_path)).write(c.run, summarize(c.run))
+    path = tmp_path / "metrics.csv"
+    text = path.read_text()
+    rows = len(load_run(str(tmp_path)).samples)
+    path.write_text(text + "12.3,0.1,")                     # the next row, half written
+    assert len(load_run(str(tmp_path)).samples) == rows
+    path.write_text(text + "12.3,0.1,\n")                   # the same cells, but a finished line
+    with pytest.raises(RunFileError, match=r"metrics.csv: line %d: 3 cells, expected" % (rows + 2)):
+        load_run(str(tmp_path))
+
+
 def test_a_slot_in_a_wall_leaves_the_steady_rms_until_it_has_been_free_for_free_hold(tmp_path):
     """A column passes a wall: the follower's slot (1 m behind the leader) crosses a block that
     fills x in [0.5, 1.5), y in [-1.5, -0.5); with 0.25 m clearance the slot is blocked for x in

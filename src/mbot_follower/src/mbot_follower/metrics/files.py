@@ -1,6 +1,7 @@
 """A Run on disk: RunWriter writes metrics.csv, events.csv, controller.csv and metrics.json;
 load_run reads them back into the same Run."""
 import csv
+import io
 import json
 import math
 import os
@@ -63,12 +64,15 @@ class RunWriter(object):
     def _append(self, name, header, items, convert):
         """Write the items that are new since the last write (all of them, with the header, the first time)."""
         done = self.written.get(name)
-        with open(self.path(name), "a" if done is not None else "w", newline="") as f:
+        # A new file is written whole and renamed, so a reader never sees it truncated.
+        path = self.path(name) if done is not None else self.path(name + ".tmp")
+        with open(path, "a" if done is not None else "w", newline="") as f:
             out = csv.writer(f)
             if done is None:
                 out.writerow(header)
-                done = 0
-            out.writerows(convert(item) for item in items[done:])
+            out.writerows(convert(item) for item in items[done or 0:])
+        if done is None:
+            os.replace(path, self.path(name))
         self.written[name] = len(items)
 
     def write(self, run, summary):
@@ -98,7 +102,12 @@ def _read_csv(path, expected=None):
     if not os.path.isfile(path):
         raise RunFileError("%s: missing (a metrics run folder holds %s)" % (path, ", ".join(FILES)))
     with open(path, newline="") as f:
-        rows = list(csv.reader(f))
+        text = f.read()
+    if text and not text.endswith("\n"):
+        # The collector appends while others read: a last line without its newline is a row
+        # still being written, not a broken file.
+        text = text[:text.rfind("\n") + 1]
+    rows = list(csv.reader(io.StringIO(text, newline="")))
     if not rows:
         raise RunFileError("%s: empty, expected a header line" % path)
     header = rows[0]
