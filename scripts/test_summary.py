@@ -16,8 +16,9 @@ e.g. `mbot_sim/gtest-test_world.xml`), each optionally followed by the least num
 cases it must hold (`mbot_sim/gtest-test_world.xml 43`). A test that a partial build loses (a
 guard in a CMakeLists, a target that failed to build) writes no result and reads as nothing at
 all; with the list it is a failure naming the missing file. A file with fewer cases than its
-minimum (a deleted or #if-ed TEST, a pytest file no longer collected: all pytest cases are in
-one pytest.xml) is a failure naming the file, the minimum and the count. Every rostest file
+minimum (a deleted or #if-ed TEST, a pytest file no longer collected: the pytest cases are in
+pytest_bringup.xml, mbot_bringup's, and pytest.xml, the others) is a failure naming the file, the
+minimum and the count. Every rostest file
 under `--src`'s packages (`src/<pkg>/test/**/*.test`) and `--system` is expected too, without a
 line (its cases are in the rosunit-*.xml of its test node, which a line can give a minimum). A
 skipped test case is a failure, and so is a result file that nothing expects: a new gtest is
@@ -147,7 +148,7 @@ def read_expected(path):
 
 def kind(name):
     """The kind of test a result file holds: gtest, rostest (its rostest-*.xml and the rosunit-*.xml
-    of its node), lint, or pytest (pytest.xml, fleet_hosts.xml)."""
+    of its node), lint, or pytest (pytest*.xml, fleet_hosts.xml)."""
     base = os.path.basename(name)
     if base.startswith("gtest-"):
         return "gtest"
