@@ -149,12 +149,14 @@ NavNode::NavNode(ros::NodeHandle nh, ros::NodeHandle private_nh) : nh_(nh), priv
 
 bool NavNode::robotPose(Pose2D& pose, std::string& error, ros::Time* stamp, bool wait) const
 {
-  // Under load this node's tf listener can fall behind /clock. Wait a little for the pose of one
-  // control period ago rather than steer on an older one: at most one period of sim time, and at
+  // Under load this node's tf listener can fall behind /clock. Wait a little for a pose at most two
+  // control periods old rather than steer on an older one: at most one period of sim time, and at
   // most 0.1 s wall, because with stage_node's lockstep sim time stands still until this node sends
   // cmd_vel. (tf2's canTransform(timeout) would sleep in sim time, i.e. until the lockstep gives up.)
+  // Two periods, not one: on a loaded machine the listener's thread often takes 10-35 ms to get a
+  // core, and waiting for the pose of one period ago made this node the last to answer the lockstep.
   const ros::Time start = ros::Time::now();
-  const ros::Time wanted = start - ros::Duration(control_period_);
+  const ros::Time wanted = start - ros::Duration(2.0 * control_period_);
   const ros::WallTime wall_deadline = ros::WallTime::now() + ros::WallDuration(0.1);
   while (wait && wanted.toSec() > 0.0 && !tf_->canTransform(global_frame_, robot_base_frame_, wanted) &&
          (ros::Time::now() - start).toSec() < control_period_ && ros::WallTime::now() < wall_deadline && ros::ok())
