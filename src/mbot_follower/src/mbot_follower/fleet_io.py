@@ -27,14 +27,15 @@ class StalePose(Exception):
 def quiet_at_shutdown(callback):
     """A timer callback that ends quietly when the node shuts down under it: rospy closes the
     publishers before it stops the timers, and a cycle running then would print a traceback
-    ("publish() to a closed topic")."""
+    ("publish() to a closed topic", or ValueError "I/O operation on closed file" when the
+    publisher's buffer closed in the middle of publish())."""
     import rospy
 
     @functools.wraps(callback)
     def wrapped(*args):
         try:
             return callback(*args)
-        except rospy.ROSException:
+        except (rospy.ROSException, ValueError):
             if rospy.is_shutdown():
                 return None
             raise

@@ -12,9 +12,20 @@ def closed_topic():
     raise rospy.ROSException("publish() to a closed topic")
 
 
-def test_a_cycle_that_publishes_as_the_node_shuts_down_ends_quietly(monkeypatch):
+def closed_buffer():
+    raise ValueError("I/O operation on closed file.")   # rospy's publish() as its buffer closes
+
+
+@pytest.mark.parametrize("cycle", [closed_topic, closed_buffer])
+def test_a_cycle_that_publishes_as_the_node_shuts_down_ends_quietly(monkeypatch, cycle):
     monkeypatch.setattr(rospy, "is_shutdown", lambda: True)
-    assert quiet_at_shutdown(closed_topic)() is None
+    assert quiet_at_shutdown(cycle)() is None
+
+
+def test_a_value_error_while_the_node_runs_is_raised(monkeypatch):
+    monkeypatch.setattr(rospy, "is_shutdown", lambda: False)
+    with pytest.raises(ValueError, match="closed file"):
+        quiet_at_shutdown(closed_buffer)()
 
 
 def test_the_same_error_while_the_node_runs_is_raised(monkeypatch):
