@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """rostest (sim_clock_rate.test): with ~clock_rate 20, stage_node publishes /clock 20 times per sim
 second, each on a multiple of 0.05 s, while robot_0's odometry keeps its 50 Hz (stamps 0.02 s
-apart) and sim time goes on as before."""
+apart) and sim time goes on as before. Lockstep with this node as its pacer: on a busy machine the
+simulator would otherwise run ahead of it and its publishers drop what this node has not read."""
 import sys
 import threading
 import unittest
@@ -10,6 +11,9 @@ import rospy
 import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+
+sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+from sim_test_tools import keep_pace  # noqa: E402
 
 
 class ClockRate(unittest.TestCase):
@@ -25,6 +29,7 @@ class ClockRate(unittest.TestCase):
             with lock:
                 odoms.append(msg.header.stamp.to_sec())
 
+        keep_pace()
         rospy.Subscriber("/clock", Clock, on_clock, queue_size=1000)
         rospy.Subscriber("/robot_0/odom", Odometry, on_odom, queue_size=1000)
         rospy.wait_for_message("/robot_0/odom", Odometry, timeout=60.0)

@@ -2,7 +2,8 @@
 """rostest (sim_fleet_truth.test): stage_node's /stage/ground_truth (mbot_msgs/RobotStates) holds,
 for each step that took ground truth, every robot's pose and twist, equal to what the robot's own
 /<robot>/base_pose_ground_truth carries at that stamp, while robot_0 drives a curve; one message
-per step (50 Hz), stamped with the step."""
+per step (50 Hz), stamped with the step. Lockstep with this node as its pacer: on a busy machine
+the simulator would otherwise run ahead of it and its publishers drop what this node has not read."""
 import math
 import sys
 import unittest
@@ -14,7 +15,7 @@ from mbot_msgs.msg import RobotStates
 from nav_msgs.msg import Odometry
 
 sys.path.insert(0, __import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-from sim_test_tools import Recorder, wait_for_connection, wait_until  # noqa: E402
+from sim_test_tools import keep_pace, Recorder, wait_for_connection, wait_until  # noqa: E402
 
 ROBOTS = ["robot_0", "robot_1", "robot_2"]
 
@@ -26,6 +27,7 @@ def yaw(q):
 class FleetTruth(unittest.TestCase):
     def test_one_message_per_step_with_every_robots_ground_truth(self):
         rospy.init_node("test_sim_fleet_truth")
+        keep_pace()
         fleet = Recorder("/stage/ground_truth", RobotStates)
         own = {r: Recorder("/%s/base_pose_ground_truth" % r, Odometry) for r in ROBOTS}
         cmd = rospy.Publisher("/robot_0/cmd_vel", Twist, queue_size=1)
