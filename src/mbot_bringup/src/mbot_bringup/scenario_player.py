@@ -301,6 +301,7 @@ class ScenarioPlayer(object):
             ok, message = self._do(step, t)
         except Exception as error:  # a service that is not there, a refused call: the step failed
             ok, message = False, "%s: %s" % (type(error).__name__, error)
+        self.timeline.done(step, self.now())
         if not ok:
             self.failed_steps += 1
         self.log.append({"t_s": round(t, 3), "step": step.key, "when": step.when(), "action": step.describe(),

@@ -247,6 +247,23 @@ def test_loss_detection_is_timed_from_the_step_to_degraded():
     assert never[0]["value"] is None and not never[0]["passed"]
 
 
+def test_loss_detection_is_timed_from_when_the_step_s_call_returned():
+    """On a loaded machine the simulator answered remove_robot 1.35 s of sim time after the call
+    (scenario leader_loss, 2.45 s measured from the step): the robot is out when the call returns."""
+    t = timeline_of("valid_every_action.yaml")
+    t.due(0.0)
+    t.observe("navigating", 1.0)
+    t.due(3.5)
+    t.observe("formed", 5.0)
+    kill, remove = [s for s in t.due(50.0) if takes_a_robot_out(s)]
+    t.done(kill, 50.1)
+    t.done(remove, 51.35)
+    t.observe("degraded", 52.6)
+    assert loss_detection_times(t) == [pytest.approx(2.5), pytest.approx(1.25)]
+    t.done(remove, 53.0)                                # DEGRADED before the call returned
+    assert loss_detection_times(t)[1] == 0.0
+
+
 def test_a_fault_that_freezes_or_silences_a_robot_is_timed_as_a_loss():
     """scenarios/faults.yaml: the laser dropout is no loss; follower_1's motors failing with its
     silence is, timed from the step to DEGRADED like a kill. A frozen drive alone counts too

@@ -75,7 +75,10 @@ blocked the leader
 waits for nobody: the follower held there also stands in the way of others (a 5-robot diamond
 that loses a front robot: its rear neighbour gets the dead robot's slot, and the other rear robot's
 new slot, the middle one, is 0.53 m beside that held neighbour), and only the leader driving on
-frees them all (benchmark seeds 2 and 8 waited 8 and 19 s before).
+frees them all (benchmark seeds 2 and 8 waited 8 and 19 s before). The standing leader blocks a
+slot in the same way where its path folds back (``fold_ratio``): a column whose leader went round
+a person in a U-turn has its next slot beside the leader, and a follower driving there is stopped
+by its safety layer, gives way and tries again for the whole ``regroup_timeout``.
 
 A formation along the path (a column) has its slots on the leader's path (trail.path_slot): the
 coordinator records the leader's path (trail.LeaderTrail, as the metrics do) from the poses of
@@ -107,8 +110,10 @@ IDLE, FORMING, NAVIGATING, ARRIVED, DEGRADED, ABORTED = (
     "IDLE", "FORMING", "NAVIGATING", "ARRIVED", "DEGRADED", "ABORTED")
 #: When the robots left cannot take the formation (a diamond of 3), the first of these that fits.
 FALLBACK_FORMATIONS = ("triangle", "wedge", "column")
-#: How blocked_followers() names a slot blocked by a lost robot standing there (_regroup reads it).
+#: How blocked_followers() names a slot blocked by a lost robot standing there, or by the standing
+#: leader where its path folds back (_regroup reads them: only the leader driving on frees either).
 BESIDE_LOST = "beside the lost "
+BESIDE_LEADER = "beside the leader "
 
 
 class CoordinatorConfig(object):
@@ -135,6 +140,10 @@ class CoordinatorConfig(object):
         # a slot this close to a lost robot standing there is blocked: a follower's safety layer
         # stops it 0.8 m short of what it drives towards, + the robot's radius 0.15 m [m]
         self.lost_clearance = 1.0
+        # a path slot nearer the leader than this share of its distance along the path (and than
+        # lost_clearance): the path folds back there (a U-turn around a person) and the slot is
+        # beside the leader, out of the follower's reach while the leader stands [-]
+        self.fold_ratio = 0.5
         self.topology = "star"                     # who follows whom: star or chain
 
 
@@ -296,8 +305,8 @@ class FleetCoordinator(object):
             self._trail.follow(leader.x, leader.y, leader.theta)
         blocked_now = self.blocked_followers(poses)
         for r, why in blocked_now.items():
-            # a wall's slot counts again free_hold after it is clear; a lost robot's at once (module docstring)
-            self._blocked_until[r] = now if why.startswith(BESIDE_LOST) else now + self.config.free_hold
+            # a wall's slot counts again free_hold after it is clear; one beside a robot at once (module docstring)
+            self._blocked_until[r] = now if why.startswith((BESIDE_LOST, BESIDE_LEADER)) else now + self.config.free_hold
             self._blocked_by[r] = why
         self.blocked = sorted(r for r, until in self._blocked_until.items() if r in blocked_now or now < until)
         self.errors = self._shape_errors(poses)
@@ -396,8 +405,8 @@ class FleetCoordinator(object):
         excused = set(excused) | set(self.blocked)
         errors = {r: e for r, e in self._regroup_errors(now, poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
-        beside_lost = [r for r in self.blocked if self._blocked_by[r].startswith(BESIDE_LOST)]
-        if beside_lost:
+        beside = [r for r in self.blocked if self._blocked_by[r].startswith((BESIDE_LOST, BESIDE_LEADER))]
+        if beside:
             # only driving on frees a slot beside a dead robot, and whoever waits behind its follower
             worst = None
         if self._regroup_since is None:
@@ -420,8 +429,8 @@ class FleetCoordinator(object):
         self._switch_waits = False  # once: a follower that cannot reach its slot is excused again
         if timed_out:
             self._no_regroup_before = now + self.config.regroup_timeout
-        if beside_lost:
-            held = beside_lost[0]
+        if beside:
+            held = beside[0]
             self.reason = "driving on: only that frees %s's slot, %s" % (held, self._blocked_by[held])
         elif timed_out and worst is not None:  # (None: every follower excused at the last moment)
             self.reason = "driving on after %.0f s of regrouping (%s %.2f m off its slot)" % (
@@ -609,11 +618,13 @@ class FleetCoordinator(object):
     def blocked_followers(self, poses):
         """{follower: why} for the followers whose slots (placed at the leader's pose now) cannot be
         driven into: "in a wall" of the map, or "beside the lost <robot>" that still stands there
-        (it has a pose: its controller died, not the robot)."""
+        (it has a pose: its controller died, not the robot), or "beside the leader <robot>" where
+        the leader's path folds back (a path slot much nearer the leader than along the path)."""
         a = self.assignment
         standing = [(r, poses[r]) for r in self.lost if r in poses]
+        slots = self.slot_poses(poses)
         result = {}
-        for r, slot in sorted(self.slot_poses(poses).items()):
+        for r, slot in sorted(slots.items()):
             if r == a.leader:
                 continue
             if self.free_space is not None and not self.free_space.is_free(slot.x, slot.y):
@@ -623,7 +634,15 @@ class FleetCoordinator(object):
                     if math.hypot(p.x - slot.x, p.y - slot.y) < self.config.lost_clearance]
             if near:
                 result[r] = BESIDE_LOST + near[0]
+            elif a.along_path and self._folded(slots[a.leader], slot, a.slots[r], a.slots[a.leader]):
+                result[r] = BESIDE_LEADER + a.leader
         return result
+
+    def _folded(self, leader_slot, slot, offset, leader_offset):
+        """The path slot lies beside the leader though far behind it along the path (config.fold_ratio)."""
+        along = math.hypot(offset[0] - leader_offset[0], offset[1] - leader_offset[1])
+        near = math.hypot(slot.x - leader_slot.x, slot.y - leader_slot.y)
+        return near < min(self.config.fold_ratio * along, self.config.lost_clearance)
 
     def _blocked_text(self):
         return " and ".join("%s's slot is %s" % (r, self._blocked_by[r]) for r in self.blocked)

@@ -107,6 +107,7 @@ class CoordinatorNode(object):
         self._last_debug = None
         self._startup_done = False
         self._waited_for = set()     # overdue robots given their wall-time wait (lockstep)
+        self._scan_waited = False    # the stale leader scan was given its wait (lockstep)
         self._last_nav = None
         self._wall_clock, self._sleep = time.monotonic, time.sleep   # unit tests inject their own
         self._wall_start = self._wall_clock()
@@ -386,16 +387,53 @@ class CoordinatorNode(object):
         self._waited_for &= overdue   # heard again: its next silence is waited for again
         if not overdue - self._waited_for:
             return poses
+        found = {}
+
+        def heard():
+            found["poses"] = self._look_up_poses(now_ros)
+            return not overdue & self._overdue(now, leader)
+
+        waited = self._wall_wait(heard)
+        if waited is not None:
+            rospy.logwarn("coordinator: the messages of %s came %.2f s of wall time late (a loaded machine)",
+                          ", ".join(sorted(overdue)), waited)
+        else:
+            self._waited_for |= self._overdue(now, leader)
+        return found.get("poses", poses)
+
+    def _wall_wait(self, done):
+        """Sleep until done() (checked every 10 ms), at most ~loss_wall_wait of wall time; returns
+        the wall time it took, None if it never came."""
         started = self._wall_clock()
         while self._wall_clock() - started < self.params["loss_wall_wait"] and not rospy.is_shutdown():
             self._sleep(0.01)
-            poses = self._look_up_poses(now_ros)
-            if not overdue & self._overdue(now, leader):
-                rospy.logwarn("coordinator: the messages of %s came %.2f s of wall time late (a loaded machine)",
-                              ", ".join(sorted(overdue)), self._wall_clock() - started)
-                return poses
-        self._waited_for |= self._overdue(now, leader)
-        return poses
+            if done():
+                return self._wall_clock() - started
+        return None
+
+    def _wait_for_scan(self, leader, now):
+        """Under lockstep, give a stale leader scan ~loss_wall_wait of wall time to come before the
+        fleet pauses for it, once per stale spell (as _wait_for_overdue does for robots): on a
+        loaded machine this node's scan thread fell 0.35 s of sim time behind and paused a fleet
+        that had a clear view (trio_switch under stress)."""
+        if not (self._startup_done and self.params["lockstep"]) or self._scan_robot != leader:
+            return
+
+        def fresh():
+            scan = self.leader_scan
+            return stale_scan(scan.header.stamp.to_sec() if scan is not None else None, now,
+                              self.params["max_scan_age"], self._scan_since) is None
+
+        if fresh():
+            self._scan_waited = False
+            return
+        if self._scan_waited:
+            return
+        self._scan_waited = True
+        waited = self._wall_wait(fresh)
+        if waited is not None:
+            rospy.logwarn("coordinator: the leader %s's scan came %.2f s of wall time late (a loaded machine)",
+                          leader, waited)
 
     def _step(self, _event):
         now_ros = rospy.Time.now()
@@ -404,6 +442,7 @@ class CoordinatorNode(object):
             self._refresh_params(now)
         leader = self.core.leader
         poses = self._wait_for_overdue(now_ros, leader, self._look_up_poses(now_ros))
+        self._wait_for_scan(leader, now)
         with self.lock:
             self.poses = poses
             leader = self.core.leader

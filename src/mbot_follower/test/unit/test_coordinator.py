@@ -770,6 +770,56 @@ def test_the_same_bent_column_measured_against_rigid_slots_is_not_formed(tmp_pat
     assert core.state() == NAVIGATING                          # arrived, but not stable
 
 
+def drive_fold_back(fold_ratio):
+    """A column of 3 (spacing 1 m, path slots) drives 3 m along +x; then the leader turns on the
+    spot to 150 deg and drives 1.6 m back (around a person, as in scenario people). The last
+    follower stays on its path slot; the first stands where the turn began, 1 m behind it, as
+    its safety layer holds it. Returns (the coordinator, [(s, actions, blocked)] of the way back)."""
+    config = CoordinatorConfig()
+    config.fold_ratio = fold_ratio
+    core = FleetCoordinator(ROBOTS, "leader", "column", 1.0, config)
+    line = lambda s: Pose2D(s, 0.0, 0.0)
+    poses = {"leader": line(0.0), "follower_1": line(-1.0), "follower_2": line(-2.0)}
+    assert core.set_goal(Pose2D(0.0, 3.0, 0.0), 0.0, poses)[0]
+    t = 0.0
+    for k in range(40):
+        t += 0.1
+        s = min(3.0, 0.1 * k)
+        poses = {"leader": line(s), "follower_1": line(s - 1.0), "follower_2": line(s - 2.0)}
+        core.update(t, poses, heard(t), leader_nav="ACTIVE")
+    assert core.phase == NAVIGATING and core.blocked == []
+    back, way = math.radians(150.0), []
+    for k in range(1, 17):
+        t += 0.1
+        d = 0.1 * k
+        poses = {"leader": Pose2D(3.0 + d * math.cos(back), d * math.sin(back), back),
+                 "follower_1": line(2.0), "follower_2": line(1.0 + d)}
+        actions = core.update(t, poses, heard(t), leader_nav="ACTIVE")
+        way.append((d, actions, list(core.blocked)))
+    return core, way
+
+
+def test_a_path_slot_beside_the_leader_where_its_path_folds_back_is_not_waited_for():
+    """The first follower's path slot runs towards the leader coming back: 0.3 m back it is 0.47 m
+    from the leader though 1 m behind it along the path. There the follower's safety layer
+    stops it, gives way and tries again: a leader waiting for it waited the whole 15 s regroup
+    timeout (scenario people, once in a proof run). Blocked beside the leader, it is not waited
+    for until the slot is clear of the leader again."""
+    core, way = drive_fold_back(fold_ratio=0.5)
+    blocked = {round(d, 1): b for d, _, b in way}
+    assert blocked[0.2] == [] and blocked[0.3] == ["follower_1"]
+    # the last slot, 2 m back along the path, comes within 1 m of the leader too (0.93 m at 0.6 m back)
+    assert blocked[0.6] == ["follower_1", "follower_2"] and blocked[1.4] == ["follower_2"]
+    assert not any(("cancel", "leader") in actions for d, actions, _ in way if d < 1.45)
+    # 1.5 m back both slots are clear of the leader: the follower 0.6 m off its slot is waited for
+    d, actions, _ = way[14]
+    assert d == pytest.approx(1.5) and blocked[1.5] == [] and ("cancel", "leader") in actions
+    assert "waits for follower_1" in core.reason
+    # without the rule the leader waits from 0.4 m back on, with the slot beside it
+    _, way = drive_fold_back(fold_ratio=0.0)
+    assert way[3][0] == pytest.approx(0.4) and ("cancel", "leader") in way[3][1]
+
+
 def test_a_new_assignment_starts_the_path_anew(tmp_path):
     core = column_core(tmp_path, along_path=True)
     _, poses = drive_l_corner(core, end=3.0)

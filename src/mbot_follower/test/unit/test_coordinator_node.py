@@ -28,6 +28,7 @@ def node(lockstep=True):
     n.last_heard_controller = {"robot_0": NOW, "robot_1": NOW - 1.5, "robot_2": NOW}
     n._startup_done = True
     n._waited_for = set()
+    n._scan_waited = False
     n._look_up_poses = lambda now_ros: {}
     n._wall_clock = FakeWallClock()
     n._sleep = n._wall_clock.sleep
@@ -139,6 +140,41 @@ def test_no_scan_pauses_once_max_scan_age_has_passed_since_the_subscription(warn
     n = scan_node(since=NOW - 0.4)
     assert n._obstacle_ahead("robot_0", NOW) == "the leader robot_0's scan: no scan yet"
     assert "robot_0" in warnings[0]
+
+
+def timed_scan_wait(n):
+    started = n._wall_clock()
+    n._wait_for_scan("robot_0", NOW)
+    return n._wall_clock() - started
+
+
+def test_under_lockstep_a_stale_scan_that_comes_within_the_wait_does_not_pause_the_fleet(warnings, monkeypatch):
+    """trio_switch under stress: the node's scan thread fell 0.35 s of sim time behind and the
+    fleet paused with a clear view. Sim time waits for this node's heartbeat meanwhile."""
+    said = []
+    monkeypatch.setattr(rospy, "logwarn", lambda text, *args: said.append(text % args))
+    n = scan_node(since=NOW - 10.0)
+    n._on_scan(scan(NOW - 0.35))
+    n._wall_clock.at(n._wall_clock() + 0.12, lambda: n._on_scan(scan(NOW - 0.05)))
+    assert 0.12 <= timed_scan_wait(n) < 0.14           # the first look after it came ends the wait
+    assert n._obstacle_ahead("robot_0", NOW) is False and warnings == []
+    assert len(said) == 1 and "the leader robot_0's scan came 0.1" in said[0] and "wall time late" in said[0]
+
+
+def test_a_scan_that_stays_stale_is_waited_for_once_per_spell_and_then_pauses(warnings):
+    n = scan_node(since=NOW - 10.0)
+    n._on_scan(scan(NOW - 0.45))
+    assert WAIT <= timed_scan_wait(n) < WAIT + 0.02     # silent: the whole wait
+    assert "0.45 s old" in n._obstacle_ahead("robot_0", NOW)
+    assert timed_scan_wait(n) == 0.0                    # the next cycles do not wait again
+    n._on_scan(scan(NOW - 0.1))                         # current again ...
+    assert timed_scan_wait(n) == 0.0
+    n._on_scan(scan(NOW - 0.45))                        # ... and stale again: a new wait
+    assert timed_scan_wait(n) >= WAIT
+    n = scan_node(since=NOW - 10.0)
+    n.params["lockstep"] = False                        # sim time would run on: waiting helps nothing
+    n._on_scan(scan(NOW - 0.45))
+    assert timed_scan_wait(n) == 0.0
 
 
 def test_the_stale_scan_pause_reaches_the_fleet_state_as_a_pause():
