@@ -610,18 +610,49 @@ class FollowerController(object):
         """The other followers' poses and slots for consensus, in the frame of the robot this one
         tracks (`reference`: the leader in a star, the robot ahead in a chain), the frame of its
         own pose and slot: the law compares (pose_j - pose_i) with (slot_j - slot_i), which mixes
-        nothing only when all four are in one frame."""
+        nothing only when all four are in one frame.
+
+        In a chain each neighbour holds its slot in the frame of the robot it tracks, which may be
+        turned against this one's (a follower that tracks this robot sits where this robot faces,
+        not where the leader does): the neighbour's pose given here is its slot plus its own slot
+        error, turned from that frame into this one. A neighbour on its chain slot is on its slot
+        here; in a star this is simply its pose.
+
+        The robots that track this one (directly or down the chain) are left out: their slots
+        swing with this robot's heading, so their errors would steer it by its own heading
+        (a rigid echelon chain did not form in 60 s with them)."""
         result = []
         for robot in a.slots:
-            if robot in (self.robot, a.leader):
+            if robot in (self.robot, a.leader) or self._tracks_me(a, robot):
                 continue
+            its_reference = a.follows.get(robot) or a.leader
+            if its_reference not in a.slots:
+                its_reference = a.leader
+            max_age = self.params["max_pose_age"]
             try:
-                pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % robot, now,
-                                      self.params["max_pose_age"])
+                pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % its_reference, "%s/base_link" % robot, now,
+                                      max_age)
+                turn = 0.0
+                if its_reference != reference:
+                    turn = lookup_pose(self.tf_buffer, "%s/base_link" % reference, "%s/base_link" % its_reference,
+                                       now, max_age)[0].theta
             except StalePose:
                 continue
-            result.append((pose, self._slot_relative_to(a, reference, robot)))
+            own_x, own_y = self._slot_relative_to(a, its_reference, robot)
+            error = transform_point(Pose2D(0.0, 0.0, turn), pose.x - own_x, pose.y - own_y)
+            slot = self._slot_relative_to(a, reference, robot)
+            result.append((Pose2D(slot[0] + error[0], slot[1] + error[1], normalize_angle(pose.theta + turn)), slot))
         return result
+
+    def _tracks_me(self, a, robot):
+        """Whether `robot` tracks this one, directly or through robots down the chain."""
+        seen = set()
+        while robot in a.follows and robot not in seen:
+            seen.add(robot)
+            robot = a.follows[robot]
+            if robot == self.robot:
+                return True
+        return False
 
     # --- outputs ------------------------------------------------------------------------------
 

@@ -325,6 +325,39 @@ def test_consensus_neighbours_in_a_chain_are_in_the_frame_of_the_robot_followed(
     assert sorted(slot for _, slot in neighbours) == pytest.approx([(-1.0, -0.6), (0.0, 0.0)])
 
 
+def test_in_a_chain_the_robots_that_track_this_one_are_no_neighbours_of_it(clock):
+    """follower_2 and follower_3 track follower_1 and hold their slots where follower_1 faces: their
+    errors swing with follower_1's heading. Compared with the leader-frame slots they pulled
+    follower_1 off its own slot (a rigid echelon chain: steady RMS 0.155-0.184 m against
+    0.04-0.05 m with slot tracking); taken in follower_1's frame they steered it by its own
+    heading (the echelon did not form in 60 s). follower_1 has no neighbours; a robot tracked
+    by nobody sees all the others."""
+    n = chain_node(clock, "consensus")
+    n.robot = "follower_1"
+    place(n, clock.t, chain_poses())
+    now = rospy.Time.from_sec(clock.t)
+    assert n._neighbours(CHAIN, now, "leader") == []
+    n.robot = "follower_3"
+    assert sorted(slot for _, slot in n._neighbours(CHAIN, now, "follower_1")) == pytest.approx(
+        [(-1.0, 0.6), (0.0, 0.0)])
+
+
+def test_in_a_chain_the_robot_tracked_is_seen_with_its_own_error(clock):
+    """follower_2 tracks follower_1: follower_1 in its own frame is always at (0, 0), so its error
+    against the leader was invisible. It is its slot error in the leader's frame, turned."""
+    from mbot_common.geometry import Pose2D, compose
+
+    n = chain_node(clock, "consensus")
+    poses = chain_poses()
+    f1 = compose(Pose2D(*poses["follower_1"]), Pose2D(0.0, 0.0, 0.0))
+    poses["follower_1"] = (f1.x + 0.3, f1.y, f1.theta)    # 0.3 m off its slot along the leader's x
+    place(n, clock.t, poses)
+    f1_seen = [pose for pose, slot in n._neighbours(CHAIN, rospy.Time.from_sec(clock.t), "follower_1")
+               if slot == pytest.approx((0.0, 0.0))][0]
+    turned = math.radians(-60)
+    assert (f1_seen.x, f1_seen.y) == pytest.approx((0.3 * math.cos(turned), 0.3 * math.sin(turned)), abs=1e-6)
+
+
 def test_the_consensus_law_runs_in_the_node_and_acts_only_on_a_neighbours_error(clock):
     """The node's cycle (tf in, cmd_vel and ~state out) with the consensus law against slot
     tracking: the same command while every neighbour is on its slot (the chain's frames agree),
