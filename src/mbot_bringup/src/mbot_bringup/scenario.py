@@ -71,7 +71,8 @@ CRITERIA = {
     "rejoins": (">=", int, "robots that rejoined"),
     "max_switch_time_s": ("<=", float, "longest time from a switch until the new shape stood [s]"),
     "max_loss_detection_s": ("<=", float, "longest time from a step that takes a robot out (kill_controller, "
-                             "remove_robot, a fault drive_frozen or silenced; from when its call returned) to DEGRADED [s]"),
+                             "remove_robot, a fault drive_frozen or silenced; from when its call "
+                             "returned) to DEGRADED [s]"),
     "max_time_to_degraded_s": ("<=", float, "longest time from a loss (the status names it lost) to DEGRADED [s]"),
     "max_recovery_time_s": ("<=", float, "longest time from a loss until the slot RMS settled [s]"),
     "duration_s": ("<=", float, "sim time the metrics cover [s]"),

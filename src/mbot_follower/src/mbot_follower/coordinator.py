@@ -306,7 +306,8 @@ class FleetCoordinator(object):
         blocked_now = self.blocked_followers(poses)
         for r, why in blocked_now.items():
             # a wall's slot counts again free_hold after it is clear; one beside a robot at once (module docstring)
-            self._blocked_until[r] = now if why.startswith((BESIDE_LOST, BESIDE_LEADER)) else now + self.config.free_hold
+            beside = why.startswith((BESIDE_LOST, BESIDE_LEADER))
+            self._blocked_until[r] = now if beside else now + self.config.free_hold
             self._blocked_by[r] = why
         self.blocked = sorted(r for r, until in self._blocked_until.items() if r in blocked_now or now < until)
         self.errors = self._shape_errors(poses)

@@ -778,7 +778,10 @@ def drive_fold_back(fold_ratio):
     config = CoordinatorConfig()
     config.fold_ratio = fold_ratio
     core = FleetCoordinator(ROBOTS, "leader", "column", 1.0, config)
-    line = lambda s: Pose2D(s, 0.0, 0.0)
+
+    def line(s):
+        return Pose2D(s, 0.0, 0.0)
+
     poses = {"leader": line(0.0), "follower_1": line(-1.0), "follower_2": line(-2.0)}
     assert core.set_goal(Pose2D(0.0, 3.0, 0.0), 0.0, poses)[0]
     t = 0.0
