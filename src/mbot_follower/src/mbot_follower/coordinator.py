@@ -114,6 +114,7 @@ FALLBACK_FORMATIONS = ("triangle", "wedge", "column")
 #: leader where its path folds back (_regroup reads them: only the leader driving on frees either).
 BESIDE_LOST = "beside the lost "
 BESIDE_LEADER = "beside the leader "
+BESIDE = (BESIDE_LOST, BESIDE_LEADER)
 
 
 class CoordinatorConfig(object):
@@ -306,7 +307,7 @@ class FleetCoordinator(object):
         blocked_now = self.blocked_followers(poses)
         for r, why in blocked_now.items():
             # a wall's slot counts again free_hold after it is clear; one beside a robot at once (module docstring)
-            beside = why.startswith((BESIDE_LOST, BESIDE_LEADER))
+            beside = why.startswith(BESIDE)
             self._blocked_until[r] = now if beside else now + self.config.free_hold
             self._blocked_by[r] = why
         self.blocked = sorted(r for r, until in self._blocked_until.items() if r in blocked_now or now < until)
@@ -406,7 +407,7 @@ class FleetCoordinator(object):
         excused = set(excused) | set(self.blocked)
         errors = {r: e for r, e in self._regroup_errors(now, poses).items() if r not in excused}
         worst = max(errors.items(), key=lambda kv: kv[1]) if errors else None
-        beside = [r for r in self.blocked if self._blocked_by[r].startswith((BESIDE_LOST, BESIDE_LEADER))]
+        beside = [r for r in self.blocked if self._blocked_by[r].startswith(BESIDE)]
         if beside:
             # only driving on frees a slot beside a dead robot, and whoever waits behind its follower
             worst = None
@@ -607,9 +608,8 @@ class FleetCoordinator(object):
     def slot_errors(self, poses):
         """{follower: (distance to its slot [m], heading error to its slot's heading [rad])}."""
         a = self.assignment
-        slots = self.slot_poses(poses)
         result = {}
-        for r, slot in sorted(slots.items()):
+        for r, slot in sorted(self.slot_poses(poses).items()):
             if r == a.leader or r not in poses:
                 continue
             result[r] = (math.hypot(poses[r].x - slot.x, poses[r].y - slot.y),
@@ -623,9 +623,8 @@ class FleetCoordinator(object):
         the leader's path folds back (a path slot much nearer the leader than along the path)."""
         a = self.assignment
         standing = [(r, poses[r]) for r in self.lost if r in poses]
-        slots = self.slot_poses(poses)
         result = {}
-        for r, slot in sorted(slots.items()):
+        for r, slot in sorted(self.slot_poses(poses).items()):
             if r == a.leader:
                 continue
             if self.free_space is not None and not self.free_space.is_free(slot.x, slot.y):
@@ -635,15 +634,15 @@ class FleetCoordinator(object):
                     if math.hypot(p.x - slot.x, p.y - slot.y) < self.config.lost_clearance]
             if near:
                 result[r] = BESIDE_LOST + near[0]
-            elif a.along_path and self._folded(slots[a.leader], slot, a.slots[r], a.slots[a.leader]):
+            elif a.along_path and self._folded(poses[a.leader], slot, a.slots[r]):
                 result[r] = BESIDE_LEADER + a.leader
         return result
 
-    def _folded(self, leader_slot, slot, offset, leader_offset):
-        """The path slot lies beside the leader though far behind it along the path (config.fold_ratio)."""
-        along = math.hypot(offset[0] - leader_offset[0], offset[1] - leader_offset[1])
-        near = math.hypot(slot.x - leader_slot.x, slot.y - leader_slot.y)
-        return near < min(self.config.fold_ratio * along, self.config.lost_clearance)
+    def _folded(self, leader, slot, offset):
+        """The path slot (`offset` from the leader's (0, 0)) lies beside the leader though far
+        behind it along the path (config.fold_ratio)."""
+        near = math.hypot(slot.x - leader.x, slot.y - leader.y)
+        return near < min(self.config.fold_ratio * math.hypot(*offset), self.config.lost_clearance)
 
     def _blocked_text(self):
         return " and ".join("%s's slot is %s" % (r, self._blocked_by[r]) for r in self.blocked)

@@ -89,6 +89,13 @@ TF_CACHE = 5.0      # [s] of poses the node's tf buffer keeps (its cache_time)
 POSE_PERIOD = 0.02  # [s] between a robot's poses (the simulator's odometry at 50 Hz)
 
 
+def reference_of(a, robot):
+    """The robot whose pose `robot` tracks in assignment `a`: the one it follows in a chain (the
+    leader in a star), or the leader when that one is no longer in the formation."""
+    reference = a.follows.get(robot) or a.leader
+    return reference if reference in a.slots else a.leader
+
+
 class FollowerController(object):
     """The ROS side of one follower: subscriptions, tf, parameters and publishing."""
 
@@ -329,9 +336,7 @@ class FollowerController(object):
             return
 
         # star: every follower tracks the leader; chain: the robot ahead of it (a.follows)
-        reference = a.follows.get(self.robot) or a.leader
-        if reference not in a.slots:
-            reference = a.leader
+        reference = reference_of(a, self.robot)
         age = self.params["max_pose_age"]
         lookup_started = time.time()
         try:
@@ -625,9 +630,7 @@ class FollowerController(object):
         for robot in a.slots:
             if robot in (self.robot, a.leader) or self._tracks_me(a, robot):
                 continue
-            its_reference = a.follows.get(robot) or a.leader
-            if its_reference not in a.slots:
-                its_reference = a.leader
+            its_reference = reference_of(a, robot)
             max_age = self.params["max_pose_age"]
             try:
                 pose, _ = lookup_pose(self.tf_buffer, "%s/base_link" % its_reference, "%s/base_link" % robot, now,

@@ -345,12 +345,10 @@ def test_in_a_chain_the_robots_that_track_this_one_are_no_neighbours_of_it(clock
 def test_in_a_chain_the_robot_tracked_is_seen_with_its_own_error(clock):
     """follower_2 tracks follower_1: follower_1 in its own frame is always at (0, 0), so its error
     against the leader was invisible. It is its slot error in the leader's frame, turned."""
-    from mbot_common.geometry import Pose2D, compose
-
     n = chain_node(clock, "consensus")
     poses = chain_poses()
-    f1 = compose(Pose2D(*poses["follower_1"]), Pose2D(0.0, 0.0, 0.0))
-    poses["follower_1"] = (f1.x + 0.3, f1.y, f1.theta)    # 0.3 m off its slot along the leader's x
+    x, y, theta = poses["follower_1"]
+    poses["follower_1"] = (x + 0.3, y, theta)    # 0.3 m off its slot along the leader's x
     place(n, clock.t, poses)
     f1_seen = [pose for pose, slot in n._neighbours(CHAIN, rospy.Time.from_sec(clock.t), "follower_1")
                if slot == pytest.approx((0.0, 0.0))][0]
